@@ -1,0 +1,35 @@
+#pragma once
+// Polar scan -> keypoints (Cen2018 or CA-CFAR) -> Cartesian image -> ORB descriptors.
+#include <memory>
+
+#include <opencv2/core/mat.hpp>
+
+#include "spinradar/core/feature_frame.hpp"
+#include "spinradar/core/params.hpp"
+#include "spinradar/core/polar_scan.hpp"
+#include "spinradar/core/stage_times.hpp"
+
+namespace spinradar {
+
+class FeatureExtractor {
+ public:
+  FeatureExtractor(const DetectorConfig& detector, const FeatureConfig& features);
+  ~FeatureExtractor();
+  FeatureExtractor(FeatureExtractor&&) noexcept;
+  FeatureExtractor& operator=(FeatureExtractor&&) noexcept;
+
+  /// Detects keypoints and computes one descriptor per kept keypoint (keypoints whose ORB
+  /// patch falls off the image are dropped, so keypoints and descriptor rows stay aligned).
+  /// Reuses internal buffers: no allocation per scan once warmed up.
+  void extract(const PolarScan& scan, FeatureFrame& out, StageTimes* times = nullptr);
+
+  /// The Cartesian image of the last extracted scan (CV_8U, cart_pixel_width square,
+  /// sensor at the centre, x forward = up, y left = left). For debug display.
+  const cv::Mat& cartesianImage() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace spinradar

@@ -1,0 +1,80 @@
+#pragma once
+// The single definition of every pipeline parameter: name, type, default, range, unit, doc.
+// Nodelets (ROS params + dynamic_reconfigure via cfg/*.cfg), the CLI (CLI11 options) and the
+// README table are all generated from these lists. Keep one entry per line (parsed by cfg/).
+#include <string>
+
+#include "spinradar/core/param_macros.hpp"
+
+// clang-format off
+#define SPINRADAR_DETECTOR_PARAMS(X) \
+  X(std::string, detector, "cen2018", 0, 0, "", "Keypoint detector: cen2018 or cfar") \
+  X(double, zq, 3.0, 0.0, 20.0, "sigma", "Cen2018 probability threshold z_q (noise std above mean)") \
+  X(int, sigma_gauss, 17, 1, 100, "bins", "Cen2018 Gaussian smoothing sigma along range") \
+  X(int, cfar_window, 40, 4, 400, "bins", "CA-CFAR training cells on each side") \
+  X(int, cfar_guard, 2, 0, 50, "bins", "CA-CFAR guard cells on each side") \
+  X(double, cfar_threshold, 2.0, 0.1, 50.0, "x mean", "CA-CFAR threshold factor over the cell average") \
+  X(double, min_range, 2.5, 0.0, 100.0, "m", "Ignore returns closer than this (vehicle, near-field leakage)") \
+  X(double, max_range, 160.0, 1.0, 500.0, "m", "Ignore returns farther than this") \
+  X(double, range_offset, 0.0, -5.0, 5.0, "m", "Added to every range (Boreas: -0.31)")
+
+#define SPINRADAR_FEATURE_PARAMS(X) \
+  X(double, cart_resolution, 0.2592, 0.01, 2.0, "m/px", "Cartesian image resolution") \
+  X(int, cart_pixel_width, 964, 64, 4096, "px", "Cartesian image width and height") \
+  X(int, orb_patch_size, 21, 5, 101, "px", "ORB descriptor patch size") \
+  X(double, nndr, 0.8, 0.1, 1.0, "", "Nearest-neighbour distance ratio for matching") \
+  X(int, max_keypoints, 0, 0, 100000, "", "Keep at most this many strongest keypoints (0 = all)")
+
+#define SPINRADAR_ESTIMATOR_PARAMS(X) \
+  X(std::string, estimator, "mc_doppler", 0, 0, "", "Motion estimator: rigid, mc, mc_doppler or refined") \
+  X(int, ransac_iterations, 100, 1, 10000, "", "RANSAC iterations") \
+  X(double, inlier_threshold, 0.35, 0.01, 5.0, "m", "RANSAC inlier threshold") \
+  X(int, ransac_seed, 7, 0, 1000000, "", "RANSAC random seed (fixed for reproducibility)") \
+  X(int, gn_iterations, 10, 1, 100, "", "Gauss-Newton iterations of MC-RANSAC refits") \
+  X(double, beta, 0.049, 0.0, 1.0, "s", "Doppler coefficient beta = f_t / (df/dt)") \
+  X(double, range_sigma, 0.0438, 0.001, 1.0, "m", "Range noise std for Cartesian covariance weighting") \
+  X(double, azimuth_sigma, 0.0045, 0.0001, 0.1, "rad", "Azimuth noise std for Cartesian covariance weighting")
+// clang-format on
+
+namespace spinradar {
+
+struct DetectorConfig {
+  SPINRADAR_DECLARE_PARAMS(SPINRADAR_DETECTOR_PARAMS)
+  void validate() const;  ///< throws std::invalid_argument naming the parameter
+};
+
+struct FeatureConfig {
+  SPINRADAR_DECLARE_PARAMS(SPINRADAR_FEATURE_PARAMS)
+  void validate() const;
+};
+
+struct EstimatorConfig {
+  SPINRADAR_DECLARE_PARAMS(SPINRADAR_ESTIMATOR_PARAMS)
+  void validate() const;
+};
+
+/// Everything the odometry pipeline needs.
+struct PipelineConfig {
+  DetectorConfig detector;
+  FeatureConfig features;
+  EstimatorConfig estimator;
+  void validate() const {
+    detector.validate();
+    features.validate();
+    estimator.validate();
+  }
+  template <class F>
+  void visit(F&& f) {
+    detector.visit(f);
+    features.visit(f);
+    estimator.visit(f);
+  }
+  template <class F>
+  void visit(F&& f) const {
+    detector.visit(f);
+    features.visit(f);
+    estimator.visit(f);
+  }
+};
+
+}  // namespace spinradar

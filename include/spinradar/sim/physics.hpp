@@ -1,0 +1,28 @@
+#pragma once
+// The physics configuration: JSON object from effect name to value, absent meaning off.
+// {"motion_distortion": true, "doppler": 0.049, "timestamp_offset": 0.03,
+//  "azimuth_offset": 0.0105, "range_offset": -0.3, "moving_objects": true}
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace spinradar::sim {
+
+struct PhysicsConfig {
+  bool motion_distortion = false;  ///< each azimuth from the pose at its own time
+  double doppler = 0.0;            ///< beta in s (0 = off): apparent range r - beta * u
+  double timestamp_offset = 0.0;   ///< s, recorded stamp minus true acquisition time
+  double azimuth_offset = 0.0;     ///< rad, reported angle minus true angle
+  double range_offset = 0.0;       ///< m, reported range minus true range
+  bool moving_objects = false;     ///< targets move with their vx, vy
+  nlohmann::json extra = nlohmann::json::object();  ///< further effects (own keys)
+
+  static PhysicsConfig fromJson(const nlohmann::json& j);  ///< unknown keys kept in extra
+  nlohmann::json toJson() const;                           ///< only effects that are on
+  static PhysicsConfig load(const std::string& path);
+  void save(const std::string& path) const;
+  /// Names of the effects that are on, in catalogue order.
+  std::vector<std::string> activeEffects() const;
+};
+
+}  // namespace spinradar::sim

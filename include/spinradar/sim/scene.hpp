@@ -1,0 +1,69 @@
+#pragma once
+// Scene (world JSON) and sensor trajectory (t,x,y,yaw CSV): the simulator's file interfaces.
+// World frame REP 103: x, y in metres, yaw CCW in radians.
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
+
+namespace spinradar::sim {
+
+struct Target {
+  double x = 0, y = 0;      ///< m
+  double rcs = 10;          ///< dBsm
+  double vx = 0, vy = 0;    ///< m/s (moving objects; extra key "vx","vy" in the JSON)
+};
+
+struct Wall {
+  double x1 = 0, y1 = 0, x2 = 0, y2 = 0;  ///< m
+  double rcs_per_m = 0;                   ///< dBsm per metre of wall
+};
+
+/// {"targets": [{"x","y","rcs"}], "walls": [{"x1","y1","x2","y2","rcs_per_m"}]} + extra keys.
+struct World {
+  std::vector<Target> targets;
+  std::vector<Wall> walls;
+  static World fromJson(const nlohmann::json& j);  ///< throws std::runtime_error with the key
+  nlohmann::json toJson() const;
+  static World load(const std::string& path);      ///< errors name the file
+  void save(const std::string& path) const;
+};
+
+struct Pose2 {
+  double x = 0, y = 0, yaw = 0;
+};
+
+/// Sensor pose over time, interpolated continuously (linear in x, y; shortest-arc in yaw).
+class Trajectory {
+ public:
+  struct Sample {
+    double t;  ///< s, same clock as scan stamps
+    Pose2 pose;
+  };
+  /// A motion-profile segment: hold speed and yaw rate for a duration.
+  struct Segment {
+    double duration;  ///< s
+    double speed;     ///< m/s along the sensor's x axis
+    double yaw_rate;  ///< rad/s, CCW
+  };
+
+  Trajectory() = default;
+  explicit Trajectory(std::vector<Sample> samples);  ///< sorted by t, at least 2
+  static Trajectory fromProfile(const std::vector<Segment>& segments, const Pose2& start,
+                                double t0, double rate_hz = 100.0);
+  static Trajectory loadCsv(const std::string& path);  ///< header t,x,y,yaw; errors name file+line
+  void saveCsv(const std::string& path) const;
+
+  Pose2 at(double t) const;                 ///< clamped outside [start, end]
+  /// Sensor body velocity [vx, vy, wz] at t (sensor frame), from the interpolated motion.
+  Eigen::Vector3d bodyVelocity(double t) const;
+  double startTime() const;
+  double endTime() const;
+  const std::vector<Sample>& samples() const { return samples_; }
+
+ private:
+  std::vector<Sample> samples_;
+};
+
+}  // namespace spinradar::sim

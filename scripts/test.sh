@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# Installs what is needed, builds, and runs every test (gtest, rostest, launch checks) via ctest.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+bash "$root/scripts/install_deps.sh"
+bash "$root/scripts/build.sh"
+build="${SPINRADAR_BUILD_DIR:-$root/build}"
+export PATH=/usr/bin:$PATH
+export ROS_LOG_DIR="$build/ros_log" ROS_HOME="$build/ros_home"
+if [ -f "$build/devel/setup.bash" ]; then set +u; source "$build/devel/setup.bash"; set -u; fi
+cd "$build"
+ctest --output-on-failure -j "${SPINRADAR_TEST_JOBS:-2}" "$@"
