@@ -1,0 +1,19 @@
+#pragma once
+// Brute-force Hamming matching of binary descriptors with the nearest-neighbour ratio test.
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+namespace spinradar {
+
+struct Match {
+  int i1 = 0;  ///< row in the first frame's descriptors / keypoints
+  int i2 = 0;  ///< row in the second frame's
+  float distance = 0.f;
+};
+
+/// For each row of d1, finds its two nearest rows of d2; keeps it when best < nndr * second.
+/// `out` is cleared and filled; buffers are reused across calls.
+void matchDescriptors(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Match>& out);
+
+}  // namespace spinradar
