@@ -1,0 +1,57 @@
+#pragma once
+// Pose CSV files: the odometry output (`t,x,y,yaw,vx,vy,wz`) and trajectories (`t,x,y,yaw`).
+// t in seconds (scan clock), x/y in metres, yaw in radians CCW (REP 103); vx, vy, wz are the
+// sensor body velocity in the sensor frame (m/s, m/s, rad/s).
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace spinradar {
+
+struct PoseRecord {
+  double t = 0.0;
+  double x = 0.0, y = 0.0, yaw = 0.0;
+  double vx = 0.0, vy = 0.0, wz = 0.0;
+};
+
+/// Pose as an SE(2) matrix T_world_sensor.
+Eigen::Matrix3d poseMatrix(double x, double y, double yaw);
+Eigen::Matrix3d poseMatrix(const PoseRecord& p);
+
+struct PoseFile {
+  std::vector<PoseRecord> poses;
+  bool has_velocity = false;  ///< the file had vx, vy, wz columns
+};
+
+/// Reads a CSV whose header names at least t, x, y, yaw (any order, extra columns ignored;
+/// vx, vy, wz read when present). Blank lines and lines starting with '#' are skipped. Throws
+/// std::runtime_error "<file>:<line>: <reason>" on a missing column, a non-number, a non-finite
+/// value, or a time that is not strictly increasing.
+PoseFile readPoseCsv(const std::string& path);
+/// Same, from a stream; `name` is used in error messages.
+PoseFile readPoseCsv(std::istream& in, const std::string& name);
+
+/// Writes `t,x,y,yaw,vx,vy,wz` (with_velocity) or `t,x,y,yaw`, full precision. Throws
+/// std::runtime_error naming the file when it cannot be written.
+void writePoseCsv(const std::string& path, const std::vector<PoseRecord>& poses,
+                  bool with_velocity = true);
+void writePoseCsv(std::ostream& out, const std::vector<PoseRecord>& poses,
+                  bool with_velocity = true);
+
+/// Incremental writer (the odometry tool writes as it goes so a long run leaves a usable file).
+class PoseCsvWriter {
+ public:
+  PoseCsvWriter(const std::string& path, bool with_velocity = true);
+  ~PoseCsvWriter();
+  void write(const PoseRecord& p);
+  void close();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace spinradar
