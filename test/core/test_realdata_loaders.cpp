@@ -63,7 +63,9 @@ TEST(RealData, BoreasRtChirps) {
   int ups = 0;
   for (int a = 0; a < 400; ++a) {
     ups += s.chirp_up[a];
-    if (a > 0) EXPECT_NE(s.chirp_up[a], s.chirp_up[a - 1]) << "row " << a;
+    if (a > 0) {
+      EXPECT_NE(s.chirp_up[a], s.chirp_up[a - 1]) << "row " << a;
+    }
   }
   EXPECT_EQ(ups, 200);
   EXPECT_EQ(countValid(s), 400);
