@@ -1,0 +1,153 @@
+#include "spinradar/core/scan_assembler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace spinradar::navtech {
+
+void ScanAssembler::setConfiguration(const Configuration& config) {
+  if (have_config_ && config == config_) return;  // re-sent on request or reconnect
+  reset();
+  config_ = config;
+  have_config_ = config.plausible();
+}
+
+void ScanAssembler::reset() {
+  if (in_rotation_) {
+    ++stats_.dropped_scans;
+    ++stats_.resets;
+  }
+  in_rotation_ = false;
+  first_after_reset_ = true;
+  last_encoder_ = -1;
+}
+
+int ScanAssembler::rowOf(uint16_t encoder) const {
+  const int n = config_.azimuth_samples, e = config_.encoder_size;
+  // Nearest row; encoder values just below the wrap belong to the last row, not to row 0.
+  return std::min(n - 1, int((int64_t(encoder) * n + e / 2) / e));
+}
+
+void ScanAssembler::begin(int bins, int bit_depth) {
+  const int n = config_.azimuth_samples;
+  work_.scan.resize(n, bins);
+  std::fill(work_.scan.valid.begin(), work_.scan.valid.end(), uint8_t(0));
+  work_.scan.range_resolution = config_.rangeResolution();
+  work_.scan.range_offset = config_.range_offset;
+  work_.scan.encoder_size = config_.encoder_size;
+  work_.bit_depth = bit_depth;
+  if (bit_depth == 16)
+    work_.power16.assign(size_t(n) * bins, 0);
+  else
+    work_.power16.clear();
+  work_.config = config_;
+  work_.malformed = 0;
+  filled_.assign(n, 0);
+  in_rotation_ = true;
+  first_row_ = -1;
+}
+
+bool ScanAssembler::add(const FftData& msg, int64_t stamp_ns, int64_t receive_ns,
+                        AssembledScan& out) {
+  if (!have_config_ || msg.encoder >= config_.encoder_size || msg.power.empty()) {
+    ++stats_.malformed;
+    if (in_rotation_) ++work_.malformed;
+    return false;
+  }
+  bool closed = false;
+  if (in_rotation_ && msg.encoder < last_encoder_) closed = finish(out);
+  if (!in_rotation_) begin(int(msg.power.size()), msg.bit_depth);
+  last_encoder_ = msg.encoder;
+  last_receive_ns_ = receive_ns;
+  if (int(msg.power.size()) != work_.scan.bins || msg.bit_depth != work_.bit_depth) {
+    ++stats_.malformed;
+    ++work_.malformed;
+    return closed;
+  }
+  const int row = rowOf(msg.encoder);
+  if (first_row_ < 0) first_row_ = row;
+  if (filled_[row]) {
+    filled_[row] = 2;
+  } else {
+    filled_[row] = 1;
+    PolarScan& s = work_.scan;
+    s.encoder[row] = msg.encoder;
+    s.azimuth[row] = 2.0 * M_PI * msg.encoder / config_.encoder_size;
+    s.stamp_ns[row] = stamp_ns;
+    uint8_t* dst = s.row(row);
+    const size_t nb = msg.power.size();
+    if (work_.bit_depth == 16) {
+      std::copy(msg.power.begin(), msg.power.end(), work_.power16.begin() + long(row * nb));
+      const double k = 1.0 / opt_.fft16_divisor;
+      for (size_t b = 0; b < nb; ++b)
+        dst[b] = uint8_t(std::min(255.0, std::floor(msg.power[b] * k + 0.5)));
+    } else {
+      for (size_t b = 0; b < nb; ++b) dst[b] = uint8_t(msg.power[b]);
+    }
+  }
+  // The last row completes the rotation now instead of one message later at the wrap.
+  if (row == config_.azimuth_samples - 1 && !closed) {
+    closed = finish(out);
+    last_encoder_ = -1;
+  }
+  return closed;
+}
+
+bool ScanAssembler::finish(AssembledScan& out) {
+  in_rotation_ = false;
+  const bool partial = first_after_reset_ && first_row_ != 0;
+  first_after_reset_ = false;
+  PolarScan& s = work_.scan;
+  const int n = s.azimuths;
+  int missing = 0, duplicated = 0, first_valid = -1, last_valid = -1;
+  for (int a = 0; a < n; ++a) {
+    if (filled_[a] == 0) ++missing;
+    if (filled_[a] == 2) ++duplicated;
+    if (filled_[a] == 1) {
+      s.valid[a] = 1;
+      if (first_valid < 0) first_valid = a;
+      last_valid = a;
+    }
+  }
+  stats_.missing_azimuths += uint64_t(missing);
+  stats_.duplicated_azimuths += uint64_t(duplicated);
+  const int valid = n - missing - duplicated;
+  if ((partial && opt_.drop_partial) || valid < opt_.min_valid_fraction * n || first_valid < 0) {
+    ++stats_.dropped_scans;
+    return false;
+  }
+  // Rows without data: nominal encoder and angle, stamps interpolated between valid rows.
+  double dt = 1e9 / (config_.rotationHz() > 0 ? config_.rotationHz() * n : 4.0 * n);
+  if (last_valid > first_valid)
+    dt = double(s.stamp_ns[last_valid] - s.stamp_ns[first_valid]) / (last_valid - first_valid);
+  int prev = -1;
+  for (int a = 0; a < n; ++a) {
+    if (filled_[a] == 1) {
+      prev = a;
+      continue;
+    }
+    if (filled_[a] == 2) continue;  // keeps the first copy's encoder and stamp
+    s.encoder[a] = uint16_t((int64_t(a) * config_.encoder_size + n / 2) / n);
+    s.azimuth[a] = 2.0 * M_PI * s.encoder[a] / config_.encoder_size;
+    int next = a + 1;
+    while (next < n && filled_[next] != 1) ++next;
+    if (prev >= 0 && next < n)
+      s.stamp_ns[a] = s.stamp_ns[prev] + (s.stamp_ns[next] - s.stamp_ns[prev]) * (a - prev) /
+                                             (next - prev);
+    else if (prev >= 0)
+      s.stamp_ns[a] = s.stamp_ns[prev] + int64_t(dt * (a - prev));
+    else
+      s.stamp_ns[a] = s.stamp_ns[first_valid] - int64_t(dt * (first_valid - a));
+  }
+  work_.missing = missing;
+  work_.duplicated = duplicated;
+  work_.partial = partial;
+  work_.sequence = sequence_++;
+  work_.last_receive_ns = last_receive_ns_;
+  std::swap(work_, out);
+  ++stats_.scans;
+  return true;
+}
+
+}  // namespace spinradar::navtech

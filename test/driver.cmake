@@ -1,0 +1,46 @@
+# Navtech driver: a libFuzzer target for the stream decoder, run for a bounded time by ctest.
+# The tree builds with g++; libFuzzer needs clang, so the fuzzer is compiled by a custom command
+# straight from the (ROS-free, dependency-free) protocol sources. Skipped when clang or its
+# libFuzzer runtime (Debian: clang, libclang-rt-14-dev) is missing.
+find_program(SPINRADAR_CLANGXX NAMES clang++ clang++-16 clang++-15 clang++-14)
+set(SPINRADAR_FUZZ_OK OFF)
+if(SPINRADAR_CLANGXX)
+  set(probe_dir ${CMAKE_BINARY_DIR}/fuzz_probe)
+  file(MAKE_DIRECTORY ${probe_dir})
+  file(WRITE ${probe_dir}/probe.cpp
+    "#include <cstdint>\n#include <cstddef>\nextern \"C\" int LLVMFuzzerTestOneInput(const uint8_t*, size_t) { return 0; }\n")
+  execute_process(COMMAND ${SPINRADAR_CLANGXX} -fsanitize=fuzzer,address probe.cpp -o probe
+    WORKING_DIRECTORY ${probe_dir} RESULT_VARIABLE probe_rc OUTPUT_QUIET ERROR_QUIET)
+  if(probe_rc EQUAL 0)
+    set(SPINRADAR_FUZZ_OK ON)
+  endif()
+endif()
+
+if(SPINRADAR_FUZZ_OK)
+  set(fuzz_bin ${CMAKE_BINARY_DIR}/fuzz_navtech_stream)
+  set(fuzz_srcs
+    ${PROJECT_SOURCE_DIR}/test/fuzz/fuzz_navtech_stream.cpp
+    ${PROJECT_SOURCE_DIR}/src/core/navtech_protocol.cpp
+    ${PROJECT_SOURCE_DIR}/src/core/navtech_time.cpp
+    ${PROJECT_SOURCE_DIR}/src/core/scan_assembler.cpp)
+  set(fuzz_hdrs
+    ${PROJECT_SOURCE_DIR}/include/spinradar/core/navtech_protocol.hpp
+    ${PROJECT_SOURCE_DIR}/include/spinradar/core/navtech_time.hpp
+    ${PROJECT_SOURCE_DIR}/include/spinradar/core/scan_assembler.hpp
+    ${PROJECT_SOURCE_DIR}/include/spinradar/core/polar_scan.hpp)
+  add_custom_command(OUTPUT ${fuzz_bin}
+    COMMAND ${SPINRADAR_CLANGXX} -std=c++17 -g -O1 -fsanitize=fuzzer,address,undefined
+            -fno-sanitize-recover=undefined -I${PROJECT_SOURCE_DIR}/include ${fuzz_srcs} -o ${fuzz_bin}
+    DEPENDS ${fuzz_srcs} ${fuzz_hdrs}
+    COMMENT "Building the Navtech stream fuzzer with ${SPINRADAR_CLANGXX}" VERBATIM)
+  add_custom_target(fuzz_navtech_stream ALL DEPENDS ${fuzz_bin})
+  # New inputs go to a scratch corpus in the build tree; the committed seeds are read-only.
+  set(fuzz_corpus ${CMAKE_BINARY_DIR}/fuzz_navtech_corpus)
+  file(MAKE_DIRECTORY ${fuzz_corpus})
+  add_test(NAME fuzz_navtech_stream
+    COMMAND ${fuzz_bin} -max_total_time=20 -timeout=10 -rss_limit_mb=2048 -max_len=16384
+            -print_final_stats=1 ${fuzz_corpus} ${PROJECT_SOURCE_DIR}/test/fuzz/seeds)
+  set_tests_properties(fuzz_navtech_stream PROPERTIES TIMEOUT 120 LABELS fuzz)
+else()
+  message(STATUS "spinradar: clang with libFuzzer not found: fuzz_navtech_stream skipped")
+endif()
