@@ -1,0 +1,42 @@
+# CLI-level tests of the offline tools (`spinradar odometry/eval/...`, README table).
+if(NOT TARGET spinradar_cli)
+  return()
+endif()
+set(_cli $<TARGET_FILE:spinradar_cli>)
+set(_tt ${PROJECT_SOURCE_DIR}/test/tools)
+set(_out ${CMAKE_BINARY_DIR}/test_tools_out)
+file(MAKE_DIRECTORY ${_out})
+
+# README parameter table must match `spinradar params` (scripts/update_readme_params.sh fixes it).
+add_test(NAME cli_readme_params_up_to_date
+  COMMAND bash ${PROJECT_SOURCE_DIR}/scripts/update_readme_params.sh --check --bin ${_cli})
+
+# Error paths: clean failure (no crash) with a message naming the file and line.
+add_test(NAME cli_eval_bad_csv_line
+  COMMAND bash ${_tt}/expect_error.sh "error: .*bad_poses.csv:3: column 'y': 'zero' is not a number"
+          ${_cli} eval --est ${_tt}/data/bad_poses.csv --gt ${_tt}/data/short_gt.csv)
+add_test(NAME cli_eval_bad_gt_line
+  COMMAND bash ${_tt}/expect_error.sh "error: .*bad_poses.csv:3:"
+          ${_cli} eval --est ${_tt}/data/short_est.csv --gt ${_tt}/data/bad_poses.csv)
+add_test(NAME cli_eval_short_sequence
+  COMMAND ${_cli} eval --est ${_tt}/data/short_est.csv --gt ${_tt}/data/short_gt.csv
+          --plot ${_out}/short_eval.png)
+set_tests_properties(cli_eval_short_sequence PROPERTIES
+  PASS_REGULAR_EXPRESSION "frame-to-frame errors \\(2\\)")
+
+# Odometry (registered once the subcommand is in the tree).
+if(EXISTS ${PROJECT_SOURCE_DIR}/src/tools/cmd_odometry.cpp)
+  add_test(NAME cli_odometry_missing_folder
+    COMMAND bash ${_tt}/expect_error.sh "error: /nonexistent/spinradar_scans: no such folder"
+            ${_cli} odometry --input /nonexistent/spinradar_scans --out ${_out}/never.csv)
+  add_test(NAME cli_odometry_empty_folder
+    COMMAND bash ${_tt}/expect_error.sh "error: .*(no scans|no scan files|empty)"
+            ${_cli} odometry --input ${_tt} --out ${_out}/never.csv --format oxford)
+  add_test(NAME cli_odometry_bad_parameter
+    COMMAND bash ${_tt}/expect_error.sh "zq"
+            ${_cli} odometry --input ${_tt} --out ${_out}/never.csv --zq -3)
+  # Real data: the Oxford sample's consecutive-scan motion against the dataset's ground truth.
+  add_test(NAME cli_odometry_oxford_sample
+    COMMAND bash ${_tt}/oxford_odometry.sh ${_cli} ${SPINRADAR_SHARED_DIR} ${_out}/oxford)
+  set_tests_properties(cli_odometry_oxford_sample PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 300)
+endif()
