@@ -17,7 +17,8 @@ if(SPINRADAR_CLANGXX)
 endif()
 
 if(SPINRADAR_FUZZ_OK)
-  set(fuzz_bin ${CMAKE_BINARY_DIR}/fuzz_navtech_stream)
+  set(fuzz_bin ${CMAKE_BINARY_DIR}/fuzz/fuzz_navtech_stream)
+  file(MAKE_DIRECTORY ${CMAKE_BINARY_DIR}/fuzz)
   set(fuzz_srcs
     ${PROJECT_SOURCE_DIR}/test/fuzz/fuzz_navtech_stream.cpp
     ${PROJECT_SOURCE_DIR}/src/core/navtech_protocol.cpp
@@ -39,7 +40,7 @@ if(SPINRADAR_FUZZ_OK)
   file(MAKE_DIRECTORY ${fuzz_corpus})
   add_test(NAME fuzz_navtech_stream
     COMMAND ${fuzz_bin} -max_total_time=20 -timeout=10 -rss_limit_mb=2048 -max_len=16384
-            -print_final_stats=1 ${fuzz_corpus} ${PROJECT_SOURCE_DIR}/test/fuzz/seeds)
+            -print_final_stats=1 -artifact_prefix=${CMAKE_BINARY_DIR}/fuzz_navtech_ ${fuzz_corpus} ${PROJECT_SOURCE_DIR}/test/fuzz/seeds)
   set_tests_properties(fuzz_navtech_stream PROPERTIES TIMEOUT 120 LABELS fuzz)
 else()
   message(STATUS "spinradar: clang with libFuzzer not found: fuzz_navtech_stream skipped")

@@ -6,6 +6,14 @@
 
 namespace spinradar::navtech {
 
+namespace {
+int64_t saturate(double t) {
+  if (!(t > -9.2e18)) return int64_t(-9.2e18);
+  if (t > 9.2e18) return int64_t(9.2e18);
+  return int64_t(t);
+}
+}  // namespace
+
 void ScanAssembler::setConfiguration(const Configuration& config) {
   if (have_config_ && config == config_) return;  // re-sent on request or reconnect
   reset();
@@ -132,13 +140,15 @@ bool ScanAssembler::finish(AssembledScan& out) {
     s.azimuth[a] = 2.0 * M_PI * s.encoder[a] / config_.encoder_size;
     int next = a + 1;
     while (next < n && filled_[next] != 1) ++next;
+    // In 128-bit / clamped double arithmetic: stamps come off the wire and may be anything.
     if (prev >= 0 && next < n)
-      s.stamp_ns[a] = s.stamp_ns[prev] + (s.stamp_ns[next] - s.stamp_ns[prev]) * (a - prev) /
-                                             (next - prev);
+      s.stamp_ns[a] = int64_t(__int128(s.stamp_ns[prev]) +
+                              (__int128(s.stamp_ns[next]) - s.stamp_ns[prev]) * (a - prev) /
+                                  (next - prev));
     else if (prev >= 0)
-      s.stamp_ns[a] = s.stamp_ns[prev] + int64_t(dt * (a - prev));
+      s.stamp_ns[a] = saturate(double(s.stamp_ns[prev]) + dt * (a - prev));
     else
-      s.stamp_ns[a] = s.stamp_ns[first_valid] - int64_t(dt * (first_valid - a));
+      s.stamp_ns[a] = saturate(double(s.stamp_ns[first_valid]) - dt * (first_valid - a));
   }
   work_.missing = missing;
   work_.duplicated = duplicated;

@@ -15,14 +15,14 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-struct Run {
+struct PollResult {
   std::vector<AssembledScan> scans;
   int disconnects = 0, timeouts = 0;
 };
 
 /// Polls until `want` scans arrived or `budget` passed; checks every scan on the way.
-Run pollScans(NavtechDriver& d, int want, double budget_s, int consumer_sleep_ms = 0) {
-  Run r;
+PollResult pollScans(NavtechDriver& d, int want, double budget_s, int consumer_sleep_ms = 0) {
+  PollResult r;
   const auto end = Clock::now() + std::chrono::duration<double>(budget_s);
   AssembledScan s;
   while (int(r.scans.size()) < want && Clock::now() < end) {
@@ -67,7 +67,7 @@ TEST(NavtechReliability, CleanStream) {
   NavtechDriver d(fastDriverConfig(server.port()));
   LogSink log;
   d.setLog(log.fn());
-  Run r = pollScans(d, 4, 10);
+  PollResult r = pollScans(d, 4, 10);
   ASSERT_EQ(r.scans.size(), 4u) << log.all();
   for (auto& s : r.scans) {
     EXPECT_EQ(s.scan.azimuths, 400);
@@ -88,7 +88,7 @@ TEST(NavtechReliability, SensorNotUpAtStartThenComesUp) {
   NavtechDriver d(fastDriverConfig(port));
   LogSink log;
   d.setLog(log.fn());
-  Run r = pollScans(d, 1, 0.6);  // connection refused for 0.6 s
+  PollResult r = pollScans(d, 1, 0.6);  // connection refused for 0.6 s
   EXPECT_TRUE(r.scans.empty());
   const uint64_t failed = d.stats().input.failed_connects;
   // Backoff 0.05, 0.1, 0.2, 0.4 s: a handful of attempts, not a busy loop.
@@ -112,7 +112,7 @@ TEST(NavtechReliability, DisconnectMidRotationReconnects) {
   NavtechDriver d(fastDriverConfig(server.port()));
   LogSink log;
   d.setLog(log.fn());
-  Run r = pollScans(d, 5, 15);
+  PollResult r = pollScans(d, 5, 15);
   EXPECT_EQ(r.scans.size(), 5u) << log.all();
   EXPECT_EQ(r.disconnects, 2);
   EXPECT_GE(d.stats().input.connects, 3u);
@@ -135,7 +135,7 @@ TEST(NavtechReliability, RestartWithNewConfiguration) {
   NavtechDriver d(fastDriverConfig(server.port()));
   LogSink log;
   d.setLog(log.fn());
-  Run r = pollScans(d, 4, 15);
+  PollResult r = pollScans(d, 4, 15);
   ASSERT_EQ(r.scans.size(), 4u) << log.all();
   EXPECT_EQ(r.scans.front().scan.bins, 64);
   EXPECT_EQ(r.scans.back().scan.azimuths, 200);
@@ -155,7 +155,7 @@ TEST(NavtechReliability, NewConfigurationMidStream) {
   NavtechDriver d(fastDriverConfig(server.port()));
   LogSink log;
   d.setLog(log.fn());
-  Run r = pollScans(d, 4, 15);
+  PollResult r = pollScans(d, 4, 15);
   ASSERT_EQ(r.scans.size(), 4u) << log.all();
   EXPECT_EQ(r.scans.back().scan.bins, 32);
   EXPECT_EQ(r.disconnects, 0);
@@ -169,7 +169,7 @@ TEST(NavtechReliability, StalledStreamReconnects) {
   NavtechDriver d(fastDriverConfig(server.port()));  // stall_timeout 0.4 s
   LogSink log;
   d.setLog(log.fn());
-  Run r = pollScans(d, 4, 15);
+  PollResult r = pollScans(d, 4, 15);
   EXPECT_EQ(r.scans.size(), 4u) << log.all();
   EXPECT_GE(r.disconnects, 1);
   EXPECT_TRUE(log.contains("stalled stream")) << log.all();
@@ -188,7 +188,7 @@ TEST(NavtechReliability, CorruptedBytesNeverMakeMalformedScans) {
   NavtechDriver d(c);
   LogSink log;
   d.setLog(log.fn());
-  Run r = pollScans(d, 6, 20);
+  PollResult r = pollScans(d, 6, 20);
   EXPECT_EQ(r.scans.size(), 6u) << log.all();
   const DriverStats st = d.stats();
   EXPECT_GE(st.input.stream.truncated, 2u);
@@ -211,7 +211,7 @@ TEST(NavtechReliability, SlowConsumerAtTenTimesRealRate) {
   d.setLog(log.fn());
   // The consumer takes 150 ms per scan while the sensor makes one every 25 ms: TCP pushes
   // back, the emulator waits (or drops us), the driver must only ever return whole scans.
-  Run r = pollScans(d, 8, 20, 150);
+  PollResult r = pollScans(d, 8, 20, 150);
   EXPECT_EQ(r.scans.size(), 8u) << log.all();
 }
 
@@ -222,7 +222,7 @@ TEST(NavtechReliability, BigEndianSensorTimeAutoDetected) {
   NavtechServer server(o, patternSource());
   server.start();
   NavtechDriver d(fastDriverConfig(server.port()));
-  Run r = pollScans(d, 2, 10);
+  PollResult r = pollScans(d, 2, 10);
   ASSERT_EQ(r.scans.size(), 2u);
   EXPECT_EQ(d.stats().byte_order, TimeByteOrder::Big);
   const auto& p = r.scans.back().scan;
