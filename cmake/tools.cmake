@@ -1,14 +1,52 @@
-# The `spinradar` command-line program (one subcommand per file in src/tools/).
+# The `spinradar` command-line program (one subcommand per file in src/tools/), the rosbag
+# library it uses for `spinradar bag` when catkin is present, and the `bench` target.
+
+# spinradar_bag: scan folders <-> rosbags of spinradar/RadarScan (needs rosbag and the
+# generated message; msg <-> core conversions come from spinradar_ros).
+set(SPINRADAR_BAG_CONVERSIONS ${PROJECT_SOURCE_DIR}/include/spinradar_ros/polar_scan_conversions.hpp)
+file(GLOB SPINRADAR_BAG_SOURCES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/bag/*.cpp)
+if(SPINRADAR_ROS AND SPINRADAR_BAG_SOURCES AND EXISTS ${SPINRADAR_BAG_CONVERSIONS})
+  add_library(spinradar_bag SHARED ${SPINRADAR_BAG_SOURCES})
+  target_include_directories(spinradar_bag PUBLIC ${PROJECT_SOURCE_DIR}/src/bag
+    ${CATKIN_DEVEL_PREFIX}/include ${catkin_INCLUDE_DIRS})
+  target_link_libraries(spinradar_bag PUBLIC spinradar_core ${catkin_LIBRARIES})
+  # Conversions implemented in src/ros/ are part of the nodelet library (defined later; CMake
+  # resolves the name at generation time).
+  file(GLOB SPINRADAR_BAG_CONV_SRC CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/ros/*conversions*.cpp)
+  if(SPINRADAR_BAG_CONV_SRC)
+    target_link_libraries(spinradar_bag PUBLIC spinradar_nodelets)
+  endif()
+  add_dependencies(spinradar_bag ${PROJECT_NAME}_generate_messages_cpp)
+  message(STATUS "spinradar: rosbag support for `spinradar bag` ON")
+else()
+  message(STATUS "spinradar: rosbag support for `spinradar bag` OFF (needs catkin and "
+                 "include/spinradar_ros/polar_scan_conversions.hpp)")
+endif()
+
 file(GLOB SPINRADAR_TOOL_SOURCES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/tools/*.cpp)
 if(SPINRADAR_TOOL_SOURCES)
   add_executable(spinradar_cli ${SPINRADAR_TOOL_SOURCES})
   set_target_properties(spinradar_cli PROPERTIES OUTPUT_NAME spinradar
     RUNTIME_OUTPUT_DIRECTORY ${SPINRADAR_BIN_DIR})
   target_link_libraries(spinradar_cli PRIVATE spinradar_core CLI11::CLI11)
-  target_include_directories(spinradar_cli PRIVATE ${PROJECT_SOURCE_DIR}/src/tools)
+  target_include_directories(spinradar_cli PRIVATE ${PROJECT_SOURCE_DIR}/src/tools
+    ${PROJECT_SOURCE_DIR}/src/bag)
   foreach(lib spinradar_sim spinradar_diagnose spinradar_bag)
     if(TARGET ${lib})
       target_link_libraries(spinradar_cli PRIVATE ${lib})
     endif()
   endforeach()
+  if(TARGET spinradar_bag)
+    target_compile_definitions(spinradar_cli PRIVATE SPINRADAR_HAVE_BAG=1)
+  endif()
+  if(TARGET spinradar_sim)
+    target_compile_definitions(spinradar_cli PRIVATE SPINRADAR_HAVE_SIM=1)
+  endif()
+
+  # `make bench` / `cmake --build . --target bench`: per-stage timings on a full-size scan pair.
+  add_custom_target(bench
+    COMMAND spinradar_cli bench
+    DEPENDS spinradar_cli
+    COMMENT "spinradar bench: per-stage timings (median of repeated runs) and peak memory"
+    USES_TERMINAL)
 endif()
