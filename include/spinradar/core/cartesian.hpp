@@ -1,0 +1,67 @@
+#pragma once
+// Polar scan -> square Cartesian image (sensor at the centre, x forward = up, y left = left).
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "spinradar/core/polar_scan.hpp"
+
+namespace spinradar {
+
+/// Renders polar scans into a Cartesian image through a precomputed per-pixel table. Each pixel
+/// is the average of the range bins it covers (a centred moving average over
+/// round(cart_resolution / range_resolution) bins, so that narrow returns between pixel centres
+/// are not lost), interpolated linearly between the two neighbouring azimuths. The tables
+/// depend only on the scan geometry (azimuth angles, bins, range resolution and offset) and the
+/// image geometry; they are cached and rebuilt only when one of these changes materially
+/// (azimuth angles by more than 2 % of an azimuth step). Pixels beyond the last bin are 0.
+///
+/// Pixel convention (as the Oxford SDK): pixel centres at integer (col, row), the sensor at
+/// ((W-1)/2, (W-1)/2); a point (x, y) of the REP 103 sensor frame is at
+/// col = c - y / res, row = c - x / res.
+class CartesianProjector {
+ public:
+  explicit CartesianProjector(double resolution = 0.2592, int width = 964);
+  void setImageGeometry(double resolution, int width);
+
+  /// Renders `scan` into `image` (CV_8UC1, width x width, bilinear). `extra_range_offset` is
+  /// added to scan.range_offset (the detector's range_offset, so image and keypoints agree).
+  /// Invalid rows take the data of the nearest valid row before them. No allocation once the
+  /// tables for this geometry exist and `image` has the right size.
+  void render(const PolarScan& scan, cv::Mat& image, double extra_range_offset = 0.0);
+
+  /// Fractional pixel (col, row) of a point (x, y) in the sensor frame (m).
+  cv::Point2f toPixel(double x, double y) const {
+    return {static_cast<float>(centre_ - y / resolution_), static_cast<float>(centre_ - x / resolution_)};
+  }
+  /// Sensor-frame point (x, y) of a fractional pixel (col, row).
+  cv::Point2d toMetric(const cv::Point2f& px) const {
+    return {(centre_ - px.y) * resolution_, (centre_ - px.x) * resolution_};
+  }
+
+  double resolution() const { return resolution_; }
+  int width() const { return width_; }
+  int tableBuilds() const { return builds_; }  ///< how many times the remap tables were built
+
+ private:
+  bool geometryChanged(const PolarScan& scan, double offset) const;
+  void buildTables(const PolarScan& scan, double offset);
+
+  double resolution_ = 0.2592;
+  int width_ = 964;
+  double centre_ = 481.5;
+  int builds_ = 0;
+  // geometry the tables were built for
+  int azimuths_ = -1, bins_ = -1;
+  double range_resolution_ = 0, offset_ = 0;
+  std::vector<double> angles_;
+  int box_ = 1;  ///< range bins averaged per pixel
+  // tables and scratch
+  std::vector<uint32_t> offset_table_;  ///< per pixel: index of its (row, bin) in polar_
+  std::vector<uint8_t> weight_table_;   ///< per pixel: weight of the next row, /256
+  std::vector<uint16_t> box_sum_;  ///< moving-sum scratch of one row
+  std::vector<uint8_t> polar_;  ///< (azimuths + 3) x bins: smoothed rows, row 0 again (wrap), 2 zero rows
+};
+
+}  // namespace spinradar
