@@ -1,6 +1,7 @@
 #include "spinradar/core/orb_descriptors.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -26,14 +27,46 @@ void resizeRows(cv::Mat& m, int rows, int cols) {
 }
 }  // namespace
 
-OrbDescriber::OrbDescriber(int patch_size) { setPatchSize(patch_size); }
+OrbDescriber::OrbDescriber(int patch_size, bool oriented) : oriented_(oriented) { setPatchSize(patch_size); }
 
 void OrbDescriber::setPatchSize(int patch_size) {
   if (patch_size < 5) throw std::invalid_argument("OrbDescriber: patch size must be >= 5");
   patch_size_ = patch_size;
   // One pyramid level: radar keypoints come with their own positions and a fixed scale.
   orb_ = cv::ORB::create(500, 1.2f, 1, patch_size, 0, 2, cv::ORB::HARRIS_SCORE, patch_size);
+  // Circular patch of radius patch/2: umax[v] = half width of row v (symmetric, as ORB builds it).
+  const int half = patch_size / 2;
+  umax_.assign(half + 2, 0);
+  const int vmax = static_cast<int>(std::floor(half * std::sqrt(2.0) / 2 + 1));
+  const int vmin = static_cast<int>(std::ceil(half * std::sqrt(2.0) / 2));
+  for (int v = 0; v <= vmax; ++v) umax_[v] = static_cast<int>(std::lround(std::sqrt(double(half) * half - v * v)));
+  for (int v = half, v0 = 0; v >= vmin; --v) {
+    while (umax_[v0] == umax_[v0 + 1]) ++v0;
+    umax_[v] = v0;
+    ++v0;
+  }
 }
+
+namespace {
+/// Intensity-centroid orientation (degrees) of the circular patch around integer pixel (u, v).
+float icAngle(const cv::Mat& img, int u, int v, int half, const std::vector<int>& umax) {
+  int m01 = 0, m10 = 0;
+  const uint8_t* c = img.ptr<uint8_t>(v) + u;
+  const int step = static_cast<int>(img.step1());
+  for (int x = -half; x <= half; ++x) m10 += x * c[x];
+  for (int y = 1; y <= half; ++y) {
+    int vsum = 0;
+    const int d = umax[y];
+    for (int x = -d; x <= d; ++x) {
+      const int top = c[x - y * step], bottom = c[x + y * step];
+      vsum += bottom - top;
+      m10 += x * (bottom + top);
+    }
+    m01 += y * vsum;
+  }
+  return cv::fastAtan2(float(m01), float(m10));
+}
+}  // namespace
 
 void OrbDescriber::describe(const cv::Mat& image, const CartesianProjector& projector,
                             std::vector<Keypoint>& keypoints, cv::Mat& descriptors) {
@@ -48,6 +81,18 @@ void OrbDescriber::describe(const cv::Mat& image, const CartesianProjector& proj
     keypoints.clear();
     resizeRows(descriptors, 0, 32);
     return;
+  }
+  if (oriented_) {
+    const int half = patch_size_ / 2;
+    for (auto& k : cv_kps_) {
+      const int u = cvRound(k.pt.x), v = cvRound(k.pt.y);
+      if (u >= half && v >= half && u + half < image.cols && v + half < image.rows)
+        k.angle = icAngle(image, u, v, half, umax_);
+      else
+        k.angle = 0.f;  // ORB drops it anyway (closer than the edge threshold)
+    }
+  } else {
+    for (auto& k : cv_kps_) k.angle = 0.f;
   }
   orb_->compute(image, cv_kps_, raw_);
   kept_.clear();
