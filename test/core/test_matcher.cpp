@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "../../src/core/matcher_kernels.hpp"  // to check every kernel, not only the chosen one
 #include "spinradar/core/cartesian.hpp"
 #include "spinradar/core/matcher.hpp"
 #include "spinradar/core/orb_descriptors.hpp"
@@ -69,6 +70,19 @@ TEST(Matcher, FindsPlantedPairsAndAgreesWithNaive) {
   EXPECT_EQ(m.size(), size_t(d1.rows));
   for (const auto& x : m) EXPECT_EQ(x.i2, perm[x.i1]);
   expectSame(m, naive(d1, d2, 0.8));
+  // Each kernel on its own (the AVX-512 one only where the CPU has it).
+  std::vector<Match> k;
+  detail::matchScalar(d1, d2, 0.8, k);
+  expectSame(k, naive(d1, d2, 0.8));
+  for (int rows : {1, 7, 8, 9, 64, 353}) {  // block tails of the 8-row kernel
+    const cv::Mat sub = d2.rowRange(0, rows);
+    k.clear();
+    if (detail::matchAvx512(d1, sub, 0.8, k)) {
+      expectSame(k, naive(d1, sub, 0.8));
+    } else if (rows == 1) {
+      std::printf("no AVX-512 VPOPCNTDQ on this CPU: only the portable kernel is tested\n");
+    }
+  }
   // Other widths take the generic path.
   const cv::Mat g1 = randomDescriptors(37, 61, rng), g2 = randomDescriptors(45, 61, rng);
   matchDescriptors(g1, g2, 0.95, m);
