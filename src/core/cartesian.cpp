@@ -5,6 +5,12 @@
 #include <cstring>
 #include <stdexcept>
 
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#endif
+#if defined(__SSE4_1__)
+#include <smmintrin.h>
+#endif
 
 namespace spinradar {
 
@@ -13,17 +19,36 @@ CartesianProjector::CartesianProjector(double resolution, int width) { setImageG
 void CartesianProjector::setImageGeometry(double resolution, int width) {
   if (!(resolution > 0) || width < 2)
     throw std::invalid_argument("CartesianProjector: resolution must be > 0 and width >= 2");
-  if (resolution != resolution_ || width != width_) azimuths_ = -1;  // force a rebuild
-  resolution_ = resolution;
-  width_ = width;
-  centre_ = 0.5 * (width - 1);
+  if (resolution != resolution_ || width != width_ || pixel_range_.empty()) {
+    azimuths_ = -1;  // force a rebuild
+    resolution_ = resolution;
+    width_ = width;
+    centre_ = 0.5 * (width - 1);
+    buildPixelGeometry();
+  }
+}
+
+void CartesianProjector::buildPixelGeometry() {
+  pixel_range_.resize(size_t(width_) * width_);
+  pixel_angle_.resize(size_t(width_) * width_);
+  for (int v = 0; v < width_; ++v) {
+    const double x = (centre_ - v) * resolution_;
+    for (int u = 0; u < width_; ++u) {
+      const double y = (centre_ - u) * resolution_;
+      const size_t i = size_t(v) * width_ + u;
+      pixel_range_[i] = static_cast<float>(std::hypot(x, y));
+      double turns = std::atan2(-y, x) / (2.0 * M_PI);  // clockwise from forward
+      if (turns < 0) turns += 1.0;
+      pixel_angle_[i] = static_cast<uint16_t>(std::lround(turns * 65536.0) & 0xffff);
+    }
+  }
 }
 
 bool CartesianProjector::geometryChanged(const PolarScan& scan, double offset) const {
   if (scan.azimuths != azimuths_ || scan.bins != bins_ || scan.range_resolution != range_resolution_ ||
       std::abs(offset - offset_) > 1e-9)
     return true;
-  const double tol = 0.02 * 2.0 * M_PI / std::max(1, scan.azimuths);
+  const double tol = 0.1 * 2.0 * M_PI / std::max(1, scan.azimuths);
   for (int a = 0; a < scan.azimuths; ++a)
     if (std::abs(std::remainder(scan.azimuth[a] - angles_[a], 2.0 * M_PI)) > tol) return true;
   return false;
@@ -53,36 +78,99 @@ void CartesianProjector::buildTables(const PolarScan& scan, double offset) {
     for (int a = 0; a <= n; ++a) ang[a] = ang[0] + 2.0 * M_PI * a / n;
   }
 
+  // angle (1/65536 turn) -> fractional row, walking the sweep once.
+  angle_row_.resize(65536);
+  int lo = 0;
+  for (int q = 0; q < 65536; ++q) {
+    double phi = 2.0 * M_PI * q / 65536.0;
+    while (phi < ang[0]) phi += 2.0 * M_PI;
+    while (phi >= ang[n]) phi -= 2.0 * M_PI;
+    if (phi < ang[lo]) lo = 0;  // wrapped past the sweep's start
+    while (lo + 1 < n && ang[lo + 1] <= phi) ++lo;
+    int row = lo;
+    long w = std::lround(256.0 * (phi - ang[row]) / (ang[row + 1] - ang[row]));
+    if (w >= 256) {  // rounds onto the next row (row n is row 0 again)
+      ++row;
+      w = 0;
+    }
+    angle_row_[q] = (static_cast<uint32_t>(row) << 8) | static_cast<uint32_t>(std::clamp(w, 0L, 255L));
+  }
+
   box_ = std::clamp(static_cast<int>(std::lround(resolution_ / scan.range_resolution)), 1, 255);
   const size_t bins = static_cast<size_t>(scan.bins);
   const uint32_t zero_row = static_cast<uint32_t>((n + 1) * bins);
-  offset_table_.resize(size_t(width_) * width_);
-  weight_table_.resize(size_t(width_) * width_);
+  const size_t pixels = size_t(width_) * width_;
+  offset_table_.resize(pixels);
+  weight_table_.resize(pixels);
+  const float inv_res = static_cast<float>(1.0 / scan.range_resolution);
+  const float b0 = static_cast<float>(-offset / scan.range_resolution - 0.5);
+  for (size_t i = 0; i < pixels; ++i) {
+    const float fb = pixel_range_[i] * inv_res + b0;  // fractional bin
+    const long bin = std::lround(fb);
+    if (fb < -0.5f || bin >= scan.bins) {
+      offset_table_[i] = zero_row;
+      weight_table_[i] = 0;
+      continue;
+    }
+    const uint32_t rw = angle_row_[pixel_angle_[i]];
+    offset_table_[i] = static_cast<uint32_t>(size_t(rw >> 8) * bins + size_t(std::max(0L, bin)));
+    weight_table_[i] = static_cast<uint8_t>(rw & 0xff);
+  }
+}
+
+namespace {
+#if defined(__GNUC__) && defined(__x86_64__)
+bool cpuHasAvx2() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2");
+}
+
+/// Eight pixels at a time with gathers; `pol` must be readable 3 bytes past its last row.
+__attribute__((target("avx2"))) void remapAvx2(const uint8_t* pol, int bins, const uint32_t* off, const uint8_t* wt,
+                                               uint8_t* out, int count) {
+  const __m256i lowbyte = _mm256_set1_epi32(0xff), half = _mm256_set1_epi32(128);
+  const int* base_a = reinterpret_cast<const int*>(pol);
+  const int* base_b = reinterpret_cast<const int*>(pol + bins);
+  int i = 0;
+  for (; i + 8 <= count; i += 8) {
+    const __m256i o = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(off + i));
+    const __m256i a = _mm256_and_si256(_mm256_i32gather_epi32(base_a, o, 1), lowbyte);
+    const __m256i b = _mm256_and_si256(_mm256_i32gather_epi32(base_b, o, 1), lowbyte);
+    const __m256i w = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(wt + i)));
+    const __m256i r =
+        _mm256_add_epi32(a, _mm256_srai_epi32(_mm256_add_epi32(_mm256_mullo_epi32(_mm256_sub_epi32(b, a), w), half), 8));
+    const __m128i r16 = _mm_packus_epi32(_mm256_castsi256_si128(r), _mm256_extracti128_si256(r, 1));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(out + i), _mm_packus_epi16(r16, r16));
+  }
+  for (; i < count; ++i) {
+    const uint8_t* p = pol + off[i];
+    const int a = p[0], b = p[bins];
+    out[i] = static_cast<uint8_t>(a + (((b - a) * wt[i] + 128) >> 8));
+  }
+}
+#endif
+}  // namespace
+
+void CartesianProjector::remapRows(uint8_t* image, size_t image_step) const {
+  const uint8_t* pol = polar_.data();
+  const int bins = bins_;
+  const uint32_t* off = offset_table_.data();
+  const uint8_t* wt = weight_table_.data();
+#if defined(__GNUC__) && defined(__x86_64__)
+  static const bool avx2 = cpuHasAvx2();
+  if (avx2) {
+    for (int v = 0; v < width_; ++v)
+      remapAvx2(pol, bins, off + size_t(v) * width_, wt + size_t(v) * width_, image + v * image_step, width_);
+    return;
+  }
+#endif
   for (int v = 0; v < width_; ++v) {
-    const double x = (centre_ - v) * resolution_;
+    uint8_t* out = image + v * image_step;
+    const size_t base = size_t(v) * width_;
     for (int u = 0; u < width_; ++u) {
-      const size_t i = size_t(v) * width_ + u;
-      const double y = (centre_ - u) * resolution_;
-      const double r = std::hypot(x, y);
-      const double fb = (r - offset) / scan.range_resolution - 0.5;  // fractional bin
-      const long bin = std::lround(fb);
-      if (fb < -0.5 || bin >= scan.bins) {
-        offset_table_[i] = zero_row;
-        weight_table_[i] = 0;
-        continue;
-      }
-      double phi = std::atan2(-y, x);  // clockwise from forward
-      while (phi < ang[0]) phi += 2.0 * M_PI;
-      while (phi >= ang[n]) phi -= 2.0 * M_PI;
-      const int hi = static_cast<int>(std::upper_bound(ang.begin(), ang.end(), phi) - ang.begin());
-      int lo = std::clamp(hi - 1, 0, n - 1);
-      long w = std::lround(256.0 * (phi - ang[lo]) / (ang[lo + 1] - ang[lo]));
-      if (w >= 256) {  // rounds onto the next row (row n is row 0 again)
-        ++lo;
-        w = 0;
-      }
-      offset_table_[i] = static_cast<uint32_t>(size_t(lo) * bins + size_t(std::max(0L, bin)));
-      weight_table_[i] = static_cast<uint8_t>(std::clamp(w, 0L, 255L));
+      const uint8_t* p = pol + off[base + u];
+      const int a = p[0], b = p[bins], w = wt[base + u];
+      out[u] = static_cast<uint8_t>(a + (((b - a) * w + 128) >> 8));
     }
   }
 }
@@ -95,7 +183,7 @@ void CartesianProjector::render(const PolarScan& scan, cv::Mat& image, double ex
   if (geometryChanged(scan, offset)) buildTables(scan, offset);
 
   const int n = scan.azimuths, bins = scan.bins;
-  polar_.resize(size_t(n + 3) * bins);
+  polar_.resize(size_t(n + 3) * bins + 4);  // + 4: the gather reads 4 bytes at a time
   uint8_t* pol = polar_.data();
   const bool has_valid = scan.valid.size() == size_t(n);
   int last_valid = -1;
@@ -105,7 +193,6 @@ void CartesianProjector::render(const PolarScan& scan, cv::Mat& image, double ex
   // Centred moving average over box_ bins (fewer at the ends), in fixed point.
   const int k = box_, left = (k - 1) / 2;
   const uint32_t inv = (65536u + k / 2) / k;
-  box_sum_.resize(bins);
   for (int a = 0; a < n; ++a) {
     int src = a;
     if (has_valid) {
@@ -120,15 +207,25 @@ void CartesianProjector::render(const PolarScan& scan, cv::Mat& image, double ex
       std::memcpy(dst, row, bins);
       continue;
     }
-    // Interior bins (full window): sum of k shifted copies of the row, vectorisable.
+    // Interior bins (full window): sum of k shifted copies of the row, 8 bins at a time.
     const int j0 = left, j1 = bins - (k - left);  // [j0, j1] have full windows
-    uint16_t* acc = box_sum_.data();
-    std::fill(acc + j0, acc + j1 + 1, uint16_t(0));
-    for (int t = 0; t < k; ++t) {
-      const uint8_t* src_t = row + t - left;
-      for (int j = j0; j <= j1; ++j) acc[j] = static_cast<uint16_t>(acc[j] + src_t[j]);
+    int j = j0;
+#if defined(__SSE4_1__)
+    const __m128i inv16 = _mm_set1_epi16(static_cast<short>((65536 + k - 1) / k)), rnd = _mm_set1_epi16(short(k / 2));
+    for (; j + 8 <= j1 + 1; j += 8) {
+      __m128i sum = rnd;
+      const uint8_t* src = row + j - left;
+      for (int t = 0; t < k; ++t)
+        sum = _mm_add_epi16(sum, _mm_cvtepu8_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(src + t))));
+      const __m128i avg = _mm_mulhi_epu16(sum, inv16);
+      _mm_storel_epi64(reinterpret_cast<__m128i*>(dst + j), _mm_packus_epi16(avg, avg));
     }
-    for (int j = j0; j <= j1; ++j) dst[j] = static_cast<uint8_t>((uint32_t(acc[j]) * inv + 32768u) >> 16);
+#endif
+    for (; j <= j1; ++j) {
+      uint32_t sum = 0;
+      for (int t = 0; t < k; ++t) sum += row[j - left + t];
+      dst[j] = static_cast<uint8_t>((sum * inv + 32768u) >> 16);
+    }
     auto edge = [&](int j) {  // the ends: shorter windows
       const int lo = std::max(0, j - left), hi = std::min(bins, j - left + k);
       uint32_t sum = 0;
@@ -142,17 +239,7 @@ void CartesianProjector::render(const PolarScan& scan, cv::Mat& image, double ex
   std::memset(pol + size_t(n + 1) * bins, 0, 2 * size_t(bins));
 
   image.create(width_, width_, CV_8UC1);
-  const uint32_t* off = offset_table_.data();
-  const uint8_t* wt = weight_table_.data();
-  for (int v = 0; v < width_; ++v) {
-    uint8_t* out = image.ptr<uint8_t>(v);
-    const size_t base = size_t(v) * width_;
-    for (int u = 0; u < width_; ++u) {
-      const uint8_t* p = pol + off[base + u];
-      const int a = p[0], b = p[bins], w = wt[base + u];
-      out[u] = static_cast<uint8_t>(a + (((b - a) * w + 128) >> 8));
-    }
-  }
+  remapRows(image.data, image.step);
 }
 
 }  // namespace spinradar

@@ -105,8 +105,8 @@ TEST(Cartesian, TablesAreCachedPerGeometry) {
   proj.render(s, img);
   proj.render(s, img);
   EXPECT_EQ(proj.tableBuilds(), 1);
-  PolarScan tiny = s;  // a hundredth of a step: not material
-  for (auto& a : tiny.azimuth) a += 0.0001 * 2 * M_PI / 400;
+  PolarScan tiny = s;  // one encoder count of jitter (1/14 of a step): not material
+  for (auto& a : tiny.azimuth) a += 2 * M_PI / 5600;
   proj.render(tiny, img);
   EXPECT_EQ(proj.tableBuilds(), 1);
   PolarScan shifted = s;  // half a step: rebuild
