@@ -178,6 +178,17 @@ ScanFolder::ScanFolder(const std::string& folder, ScanFormat format, ScanFolderO
   }
   std::stable_sort(files_.begin(), files_.end(),
                    [](const File& a, const File& b) { return a.stamp_ns < b.stamp_ns; });
+  // Bin count of the first scan, from its header, to catch mis-sized files on load.
+  int w = 0, h = 0;
+  if (format_ == ScanFormat::Oxford || format_ == ScanFormat::Boreas) {
+    if (pngSize(files_.front().path, w, h)) expected_bins_ = w - kNavtechMetaColumns;
+  } else if (format_ == ScanFormat::Radiate) {
+    if (pngSize(files_.front().path, w, h)) expected_bins_ = h;
+  } else if (format_ == ScanFormat::MulRan) {
+    std::ifstream f(files_.front().path);
+    std::string line;
+    if (std::getline(f, line)) expected_bins_ = static_cast<int>(std::count(line.begin(), line.end(), ',')) - 3;
+  }
   for (size_t i = 1; i < files_.size(); ++i)
     if (files_[i].stamp_ns == files_[i - 1].stamp_ns)
       scanWarning(folder + ": " + files_[i - 1].path + " and " + files_[i].path + " have the same stamp");
@@ -185,24 +196,36 @@ ScanFolder::ScanFolder(const std::string& folder, ScanFormat format, ScanFolderO
 
 PolarScan ScanFolder::load(size_t i) const {
   const File& f = files_.at(i);
+  PolarScan s;
   switch (format_) {
     case ScanFormat::Oxford:
-      return loadOxfordPng(f.path, options_.range_resolution.value_or(0.0438),
-                           options_.range_offset.value_or(0.0));
-    case ScanFormat::Boreas: {
-      PolarScan s = loadBoreasPng(f.path, options_.range_offset.value_or(kBoreasRangeOffset));
+      s = loadOxfordPng(f.path, options_.range_resolution.value_or(0.0438), options_.range_offset.value_or(0.0));
+      break;
+    case ScanFormat::Boreas:
+      s = loadBoreasPng(f.path, options_.range_offset.value_or(kBoreasRangeOffset));
       if (options_.range_resolution) s.range_resolution = *options_.range_resolution;
-      return s;
-    }
+      break;
     case ScanFormat::MulRan:
-      return loadMulranCsv(f.path, options_.range_resolution.value_or(0.0595238),
-                           options_.range_offset.value_or(0.0));
+      s = loadMulranCsv(f.path, options_.range_resolution.value_or(0.0595238), options_.range_offset.value_or(0.0));
+      break;
     case ScanFormat::Radiate:
-      return loadRadiatePng(f.path, f.stamp_ns, options_.rotation_hz,
-                            options_.range_resolution.value_or(0.17361), options_.range_offset.value_or(0.0));
-    default: break;
+      s = loadRadiatePng(f.path, f.stamp_ns, options_.rotation_hz, options_.range_resolution.value_or(0.17361),
+                         options_.range_offset.value_or(0.0));
+      break;
+    default:
+      throw std::runtime_error(dir_ + ": no format");
   }
-  throw std::runtime_error(dir_ + ": no format");
+  if (expected_bins_ > 0 && s.bins != expected_bins_) {
+    std::ostringstream m;
+    if (format_ == ScanFormat::Oxford || format_ == ScanFormat::Boreas)
+      m << f.path << ": " << s.bins + kNavtechMetaColumns << " columns but " << kNavtechMetaColumns << " + "
+        << expected_bins_ << " bins expected (as in " << files_.front().path << ")";
+    else
+      m << f.path << ": " << s.bins << " bins but " << expected_bins_ << " expected (as in " << files_.front().path
+        << ")";
+    throw std::runtime_error(m.str());
+  }
+  return s;
 }
 
 }  // namespace spinradar

@@ -252,6 +252,12 @@ TEST(ScanFolder, ListsSortedAndGuessesFormat) {
   EXPECT_EQ(f.fileStampNs(2), 3000000000LL);
   EXPECT_EQ(f.load(1).stamp_ns[0], 2000000000LL);
 
+  // A mis-sized scan in the folder is named on load.
+  saveOxfordPng(makeScan(400, 3000, 4000000LL), (d.path / "radar" / "4000000.png").string());
+  ScanFolder g(d.path.string());
+  EXPECT_EQ(g.expectedBins(), 3768);
+  expectThrowsWith([&] { g.load(3); }, {"4000000.png", "3011 columns but 11 + 3768 bins expected"});
+
   TempDir b;
   saveBoreasPng(makeScan(400, 6848, 7), b.file("7.png"));
   EXPECT_EQ(ScanFolder(b.path.string()).format(), ScanFormat::Boreas);

@@ -37,8 +37,11 @@ class ScanFolder {
   /// Time of the scan from its file name (Oxford: first azimuth, Boreas: middle azimuth,
   /// MulRan: last azimuth) or Navtech_Polar.txt (RADIATE), in ns.
   int64_t fileStampNs(size_t i) const { return files_.at(i).stamp_ns; }
-  /// Loads scan i with the folder's format and options.
+  /// Loads scan i with the folder's format and options. Throws std::runtime_error naming the
+  /// file when it cannot be read or its bin count differs from the folder's first scan.
   PolarScan load(size_t i) const;
+  /// Range bins of the folder's first scan (from its header), 0 when unknown.
+  int expectedBins() const { return expected_bins_; }
 
  private:
   struct File {
@@ -49,6 +52,7 @@ class ScanFolder {
   ScanFormat format_ = ScanFormat::Auto;
   ScanFolderOptions options_;
   std::vector<File> files_;
+  int expected_bins_ = 0;
 };
 
 }  // namespace spinradar
