@@ -3,6 +3,7 @@
 // {"motion_distortion": true, "doppler": 0.049, "timestamp_offset": 0.03,
 //  "azimuth_offset": 0.0105, "range_offset": -0.3, "moving_objects": true}
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 

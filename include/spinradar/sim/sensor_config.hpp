@@ -2,6 +2,8 @@
 // Sensor model parameters (Navtech CIR204-H defaults). One definition, like params.hpp.
 #include <string>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "spinradar/core/param_macros.hpp"
 
 // clang-format off
@@ -12,17 +14,38 @@
   X(int, bins, 3768, 16, 16384, "", "Range bins per azimuth") \
   X(double, range_resolution, 0.0438, 0.001, 1.0, "m", "Range bin size") \
   X(double, beam_width_deg, 1.8, 0.1, 20.0, "deg", "One-way -3 dB azimuth beam width") \
-  X(double, noise_floor_db, 18.0, 0.0, 100.0, "dB", "Mean receiver noise power (speckle, exponential)") \
+  X(double, noise_floor_db, 8.0, 0.0, 100.0, "dB", "Mean receiver noise power (speckle, exponential)") \
   X(double, range_gain_db_per_decade, 30.0, 0.0, 60.0, "dB/dec", "Range gain (STC) compensating spreading loss") \
   X(double, power_scale, 1.0, 0.1, 10.0, "count/dB", "Output counts per dB (Navtech: about 1)") \
-  X(double, saturation, 255.0, 1.0, 255.0, "count", "Largest output value")
+  X(double, saturation, 255.0, 1.0, 255.0, "count", "Largest output value") \
+  X(double, min_range, 0.5, 0.0, 50.0, "m", "Returns closer than this are not rendered") \
+  X(double, radar_constant_db, 80.0, 0.0, 300.0, "dB", "Received power of a 0 dBsm point at 1 m before range gain") \
+  X(double, noise_range_slope_db_per_decade, 0.0, -40.0, 40.0, "dB/dec", "Noise floor change per decade of range (from 10 m)") \
+  X(double, clutter_db, 14.0, 0.0, 80.0, "dB", "Diffuse ground clutter power at 10 m, above the noise floor") \
+  X(double, clutter_db_per_decade, -14.0, -60.0, 0.0, "dB/dec", "Ground clutter change per decade of range") \
+  X(double, range_cell_bins, 1.6, 0.5, 10.0, "bins", "Range resolution cell of the FFT (Hann mainlobe null at 2 cells)") \
+  X(int, range_psf_half_width, 24, 2, 64, "bins", "Half width of the rendered range point spread (sidelobes)") \
+  X(double, azimuth_sidelobe_db, -28.0, -80.0, -10.0, "dB", "Two-way azimuth sidelobe plateau relative to the peak") \
+  X(double, azimuth_extent_deg, 6.0, 1.0, 30.0, "deg", "Half width of the rendered azimuth pattern") \
+  X(double, incidence_exponent, 2.0, 0.0, 10.0, "", "Wall back-scatter falls as cos(incidence)^n") \
+  X(double, wall_spacing, 0.25, 0.02, 5.0, "m", "Spacing of the scatterers a wall is rendered with") \
+  X(double, wall_texture_db, 5.0, 0.0, 20.0, "dB", "Std of the per-scatterer facade texture") \
+  X(double, occlusion_tolerance, 0.25, 0.0, 5.0, "m", "Scatterers this far behind the first wall still show") \
+  X(double, render_threshold_db, -6.0, -40.0, 20.0, "dB", "Contributions below noise floor + this are skipped")
 // clang-format on
 
 namespace spinradar::sim {
 
 struct SensorConfig {
   SPINRADAR_DECLARE_PARAMS(SPINRADAR_SENSOR_PARAMS)
-  void validate() const;
+  void validate() const;  ///< throws std::invalid_argument naming the parameter
+  /// {"name": value, ...} for every parameter; fromJson takes a subset (unknown keys rejected).
+  nlohmann::json toJson() const;
+  static SensorConfig fromJson(const nlohmann::json& j);
+  static SensorConfig load(const std::string& path);  ///< errors name file + line + reason
+  void save(const std::string& path) const;
+  /// Maximum rendered range (m): bins * range_resolution.
+  double maxRange() const { return bins * range_resolution; }
 };
 
 }  // namespace spinradar::sim

@@ -1,0 +1,33 @@
+#pragma once
+// Built-in scenes: a world and a sensor trajectory through it, by name, so that nothing has to
+// be written by hand to get started.
+//   "city"         grid of blocks with facades, poles, parked and moving cars; a ~3 min route
+//                  with turns at intersections and speeds up to 15 m/s
+//   "out_and_back" a straight 1 km road with roadside structures, driven out at 10-20 m/s,
+//                  U-turn, and back on the other lane
+//   "tight_turns"  an open yard with poles, containers and walls; slalom and tight loops
+//                  (yaw rates up to ~1 rad/s) at 3-8 m/s
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "spinradar/sim/scene.hpp"
+
+namespace spinradar::sim {
+
+struct Scene {
+  std::string name;
+  std::string description;
+  World world;
+  Trajectory trajectory;
+};
+
+/// Names accepted by builtinScene().
+std::vector<std::string> builtinSceneNames();
+
+/// The scene by name. `variant` changes the random layout details (object placement,
+/// reflectivities) but not the street plan or route. `t0` is the trajectory start time (s).
+/// Throws std::invalid_argument listing the valid names for an unknown name.
+Scene builtinScene(const std::string& name, uint64_t variant = 0, double t0 = 0.0);
+
+}  // namespace spinradar::sim

@@ -1,0 +1,78 @@
+#include "spinradar/sim/sensor_config.hpp"
+
+#include <fstream>
+#include <stdexcept>
+#include <type_traits>
+
+#include <nlohmann/json.hpp>
+
+#include "file_errors.hpp"
+#include "spinradar/core/param_check.hpp"
+
+namespace spinradar::sim {
+
+void SensorConfig::validate() const {
+  checkParamRanges(*this, "sensor");
+  if (encoder_size < azimuths)
+    throw std::invalid_argument("sensor parameter 'encoder_size' must be at least 'azimuths'");
+}
+
+nlohmann::json SensorConfig::toJson() const {
+  nlohmann::json j = nlohmann::json::object();
+  visit([&](const ParamMeta& m, const auto& v) { j[m.name] = v; });
+  return j;
+}
+
+SensorConfig SensorConfig::fromJson(const nlohmann::json& j) {
+  if (!j.is_object()) throw detail::JsonPathError({}, "sensor configuration must be a JSON object");
+  SensorConfig c;
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    bool found = false;
+    c.visit([&](const ParamMeta& m, auto& v) {
+      if (it.key() != m.name) return;
+      found = true;
+      using T = std::decay_t<decltype(v)>;
+      if constexpr (std::is_same_v<T, bool>) {
+        if (!it->is_boolean()) throw detail::JsonPathError({{m.name, -1}}, "must be true or false");
+        v = it->template get<bool>();
+      } else if constexpr (std::is_arithmetic_v<T>) {
+        if (!it->is_number()) throw detail::JsonPathError({{m.name, -1}}, "must be a number");
+        v = it->template get<T>();
+        if (v < m.min || v > m.max)
+          throw detail::JsonPathError({{m.name, -1}}, "value outside [" + std::to_string(m.min) +
+                                                          ", " + std::to_string(m.max) + "]");
+      } else {
+        if (!it->is_string()) throw detail::JsonPathError({{m.name, -1}}, "must be a string");
+        v = it->template get<std::string>();
+      }
+    });
+    if (!found) throw detail::JsonPathError({{it.key(), -1}}, "unknown sensor parameter");
+  }
+  try {
+    c.validate();
+  } catch (const std::invalid_argument& e) {
+    throw detail::JsonPathError({}, e.what());
+  }
+  return c;
+}
+
+SensorConfig SensorConfig::load(const std::string& path) {
+  std::string text = detail::readFile(path);
+  nlohmann::json j = detail::parseJson(text, path);
+  try {
+    return fromJson(j);
+  } catch (const detail::JsonPathError& e) {
+    std::string where = detail::pathString(e.path);
+    detail::fail(path, detail::jsonLineOf(text, e.path),
+                 where.empty() ? e.reason : where + ": " + e.reason);
+  }
+}
+
+void SensorConfig::save(const std::string& path) const {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write");
+  out << toJson().dump(1) << "\n";
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
+
+}  // namespace spinradar::sim
