@@ -1,0 +1,409 @@
+// The diagnosis pipeline: re-simulate, associate, regress, fit, re-simulate with the fit.
+#include "spinradar/diagnose/diagnose.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "spinradar/diagnose/advice.hpp"
+#include "spinradar/sim/simulator.hpp"
+
+namespace spinradar::diagnose {
+namespace {
+
+double wrapPi(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+struct Measured {
+  bool ok = false;
+  double range = 0, azimuth = 0;
+};
+
+// Renders the scan whose recorded first stamp is that of `real` under `physics` and measures
+// every view's peak in it.
+std::vector<Measured> measureSimulated(const sim::Simulator& sim, const PolarScan& real,
+                                       const ScanGeometry& geo_real,
+                                       const std::vector<const Observation*>& views,
+                                       const std::vector<Gate>& gates, const DiagnoseInput& in,
+                                       const DiagnoseOptions& opt) {
+  const sim::PhysicsConfig& ph = sim.physics();
+  const double t0 = geo_real.firstStamp() - ph.timestamp_offset;
+  PolarScan s = sim.renderScanAt(t0);
+  s.range_offset = real.range_offset;  // both read with the recording's bin convention
+  s.range_resolution = real.range_resolution;
+  const ScanGeometry geo = ScanGeometry::fromScan(s);
+  std::vector<Measured> out(views.size());
+  for (size_t i = 0; i < views.size(); ++i) {
+    const Prediction p = predictTarget(in.world.targets[views[i]->target], geo, in.trajectory, ph,
+                                       opt.conventions);
+    if (!p.ok) continue;
+    const auto pk = measurePeak(s, geo, p.range, p.azimuth, gates[i], opt.peaks);
+    if (!pk) continue;
+    out[i] = {true, pk->range, pk->azimuth};
+  }
+  return out;
+}
+
+ResidualStats stats(const std::vector<Observation>& obs, const std::vector<double>& er,
+                    const std::vector<double>& eaz, const std::vector<bool>& use, double sweep) {
+  ResidualStats s;
+  double sp = 0, sr = 0, sa = 0;
+  for (size_t i = 0; i < obs.size(); ++i) {
+    if (!use[i] || !std::isfinite(er[i])) continue;
+    const double et = obs[i].range * eaz[i];
+    sp += er[i] * er[i] + et * et;
+    sr += er[i] * er[i];
+    sa += eaz[i] * eaz[i];
+    ++s.n;
+  }
+  if (s.n == 0) return s;
+  s.position_rms = std::sqrt(sp / s.n);
+  s.range_rms = std::sqrt(sr / s.n);
+  s.azimuth_rms = std::sqrt(sa / s.n);
+  s.time_rms = s.azimuth_rms / (2.0 * M_PI) * sweep;
+  return s;
+}
+
+// The regression problem on the inliers: stacked whitened range and azimuth residuals.
+struct Design {
+  Eigen::VectorXd y;
+  Eigen::MatrixXd N, C, A;  // nuisance (none by default), candidates, per-scan rigid alignment
+  std::vector<int> rows;    // observation of each stacked row
+};
+
+Design buildDesign(const std::vector<Observation>& obs, const std::vector<Effect>& cands,
+                   double sr, double sa, int n_scans) {
+  Design d;
+  std::vector<int> idx;
+  for (size_t i = 0; i < obs.size(); ++i)
+    if (obs[i].inlier) idx.push_back(static_cast<int>(i));
+  const int m = static_cast<int>(idx.size());
+  d.y.resize(2 * m);
+  d.N.resize(2 * m, 0);
+  d.C.resize(2 * m, static_cast<int>(cands.size()));
+  d.A = Eigen::MatrixXd::Zero(2 * m, 3 * n_scans);
+  for (int j = 0; j < m; ++j) {
+    const Observation& o = obs[idx[j]];
+    d.y(j) = o.e_r / sr;
+    d.y(m + j) = o.e_az / sa;
+    for (size_t k = 0; k < cands.size(); ++k) {
+      const int e = static_cast<int>(cands[k]);
+      d.C(j, k) = o.dr[e] / sr;
+      d.C(m + j, k) = o.daz[e] / sa;
+    }
+    for (int q = 0; q < 3; ++q) {
+      d.A(j, 3 * o.scan + q) = o.nr[q] / sr;
+      d.A(m + j, 3 * o.scan + q) = o.naz[q] / sa;
+    }
+    d.rows.push_back(idx[j]);
+  }
+  return d;
+}
+
+}  // namespace
+
+double Observation::radialVelocity() const {
+  // Ray direction in the sensor frame for a clockwise azimuth: (cos, -sin).
+  return vx * std::cos(azimuth) - vy * std::sin(azimuth);
+}
+
+DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
+  const auto t_start = std::chrono::steady_clock::now();
+  DiagnoseReport rep;
+  rep.base = in.base;
+  rep.scans = static_cast<int>(in.scans.size());
+  if (in.scans.empty()) throw std::runtime_error("diagnose: the recording holds no scans");
+
+  std::vector<Effect> cands;
+  for (Effect e : allEffects())
+    if (!(e == Effect::MotionDistortion && in.base.motion_distortion)) cands.push_back(e);
+  for (Effect e : cands) rep.effect_names_tested.push_back(effectName(e));
+
+  // 1. Predict, re-simulate with the base physics, measure both, build regressors.
+  sim::Simulator base_sim(in.world, in.trajectory, in.sensor, in.base, opt.seed);
+  std::vector<ScanGeometry> geos;
+  std::vector<std::vector<int>> obs_of_scan(in.scans.size());
+  std::vector<Gate> gate_of_obs;
+  double sweep = 0;
+  for (size_t k = 0; k < in.scans.size(); ++k) {
+    const PolarScan& real = in.scans[k];
+    geos.push_back(ScanGeometry::fromScan(real));
+    const ScanGeometry& geo = geos.back();
+    sweep += geo.sweep / in.scans.size();
+    const auto views = targetViews(static_cast<int>(k), real, geo, in.world, in.trajectory,
+                                   in.base, opt.conventions, opt.views);
+    std::vector<Observation> cand_obs;
+    std::vector<Gate> gates;
+    for (const TargetView& v : views) {
+      const auto pk = measurePeak(real, geo, v.pred.range, v.pred.azimuth, v.gate, opt.peaks);
+      if (!pk) continue;
+      Observation o;
+      o.scan = static_cast<int>(k);
+      o.target = v.target;
+      o.range = v.pred.range;
+      o.azimuth = v.pred.azimuth;
+      o.stamp = v.pred.stamp;
+      o.tau = v.pred.stamp - geo.firstStamp();
+      const double t_true = v.pred.stamp - in.base.timestamp_offset;
+      const Eigen::Vector3d vel = in.trajectory.bodyVelocity(t_true);
+      o.vx = vel.x();
+      o.vy = vel.y();
+      o.yaw_rate = vel.z();
+      o.yaw = in.trajectory.at(t_true).yaw;
+      o.real_r = pk->range;
+      o.real_az = pk->azimuth;
+      const sim::Target& tg = in.world.targets[v.target];
+      for (Effect e : cands) {
+        const double h = effectStep(e);
+        const Prediction pe = predictTarget(tg, geo, in.trajectory, withEffect(in.base, e, h),
+                                            opt.conventions);
+        o.dr[static_cast<int>(e)] = (pe.range - v.pred.range) / h;
+        o.daz[static_cast<int>(e)] = wrapPi(pe.azimuth - v.pred.azimuth) / h;
+      }
+      const double hp = 0.01, ha = 0.001;
+      const PoseDelta deltas[3] = {{hp, 0, 0}, {0, hp, 0}, {0, 0, ha}};
+      const double steps[3] = {hp, hp, ha};
+      for (int q = 0; q < 3; ++q) {
+        const Prediction pq =
+            predictTarget(tg, geo, in.trajectory, in.base, opt.conventions, deltas[q]);
+        o.nr[q] = (pq.range - v.pred.range) / steps[q];
+        o.naz[q] = wrapPi(pq.azimuth - v.pred.azimuth) / steps[q];
+      }
+      cand_obs.push_back(o);
+      gates.push_back(v.gate);
+    }
+    std::vector<const Observation*> ptrs;
+    for (const auto& o : cand_obs) ptrs.push_back(&o);
+    const auto sim_meas = measureSimulated(base_sim, real, geo, ptrs, gates, in, opt);
+    for (size_t i = 0; i < cand_obs.size(); ++i) {
+      if (!sim_meas[i].ok) continue;
+      Observation o = cand_obs[i];
+      o.e_r = o.real_r - sim_meas[i].range;
+      o.e_az = wrapPi(o.real_az - sim_meas[i].azimuth);
+      obs_of_scan[k].push_back(static_cast<int>(rep.obs.size()));
+      rep.obs.push_back(o);
+      gate_of_obs.push_back(gates[i]);
+    }
+  }
+  if (rep.obs.size() < 10)
+    throw std::runtime_error("diagnose: only " + std::to_string(rep.obs.size()) +
+                             " target returns could be associated (need isolated point targets "
+                             "of the world inside the radar's range)");
+  {
+    std::vector<int> t;
+    for (const auto& o : rep.obs) t.push_back(o.target);
+    std::sort(t.begin(), t.end());
+    rep.targets_used = static_cast<int>(std::unique(t.begin(), t.end()) - t.begin());
+  }
+
+  // 2. Two passes: robust scales and outliers from the base residuals, then from the fit.
+  std::vector<double> er, eaz;
+  for (const auto& o : rep.obs) {
+    er.push_back(o.e_r);
+    eaz.push_back(o.e_az);
+  }
+  double sr = std::max(robustSigma(er), 1e-4), sa = std::max(robustSigma(eaz), 1e-5);
+  {
+    std::vector<double> a = er, b = eaz;
+    std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
+    std::nth_element(b.begin(), b.begin() + b.size() / 2, b.end());
+    const double mr = a[a.size() / 2], ma = b[b.size() / 2];
+    for (auto& o : rep.obs)
+      o.inlier = std::fabs(o.e_r - mr) < 2.0 * opt.outlier_sigma * sr &&
+                 std::fabs(o.e_az - ma) < 2.0 * opt.outlier_sigma * sa;
+  }
+  SelectionOptions so;
+  so.alpha = opt.alpha;
+  SelectionResult sel;
+  Design d;
+  for (int pass = 0; pass < 2; ++pass) {
+    d = buildDesign(rep.obs, cands, sr, sa, rep.scans);
+    sel = stepwiseSelect(d.y, d.N, d.C, so);
+    // Residuals of every observation under the joint fit.
+    std::vector<double> rr, ra;
+    for (auto& o : rep.obs) {
+      double fr = o.e_r, fa = o.e_az;
+      for (size_t i = 0; i < sel.selected.size(); ++i) {
+        const int e = static_cast<int>(cands[sel.selected[i]]);
+        fr -= sel.joint.coef(i) * o.dr[e];
+        fa -= sel.joint.coef(i) * o.daz[e];
+      }
+      o.fit_r = fr;
+      o.fit_az = fa;
+      if (o.inlier) {
+        rr.push_back(fr);
+        ra.push_back(fa);
+      }
+    }
+    if (pass == 1) break;
+    sr = std::max(robustSigma(rr), 1e-4);
+    sa = std::max(robustSigma(ra), 1e-5);
+    for (auto& o : rep.obs)
+      o.inlier = std::fabs(o.fit_r) < opt.outlier_sigma * sr &&
+                 std::fabs(o.fit_az) < opt.outlier_sigma * sa;
+  }
+  rep.sigma_r = sr;
+  rep.sigma_az = sa;
+  for (const auto& o : rep.obs) rep.outliers += o.inlier ? 0 : 1;
+  rep.candidate_corr = sel.corr;
+
+  // 3. Candidate table (step 1) and per-scan-alignment absorbed fractions.
+  const Eigen::VectorXd cand_vif = vif(d.N, d.C);
+  for (size_t k = 0; k < cands.size(); ++k) {
+    CandidateRow c;
+    c.effect = cands[k];
+    for (const auto& t : sel.steps.front().tests)
+      if (t.index == static_cast<int>(k)) {
+        c.estimate = effectValue(in.base, cands[k]) + t.coef;
+        c.stddev = t.stddev;
+        c.z = t.z;
+        c.lr = t.lr;
+        c.lm = t.lm;
+        c.p = t.p;
+        c.delta_bic = t.delta_bic;
+        c.absorbed = t.absorbed_nuisance;
+      }
+    c.absorbed_by_alignment = absorbedFraction(d.A, d.C.col(k));
+    c.vif = cand_vif.size() ? cand_vif(k) : 1.0;
+    rep.candidates.push_back(c);
+  }
+
+  // 4. Selected effects, joint estimates, confounding notes.
+  sim::PhysicsConfig fitted = in.base;
+  for (size_t i = 0; i < sel.selected.size(); ++i) {
+    const int k = sel.selected[i];
+    const SelectionStep& st = sel.steps[i];
+    EffectResult r;
+    r.effect = cands[k];
+    r.name = effectName(r.effect);
+    r.parameter = effectParameter(r.effect);
+    r.unit = effectUnit(r.effect);
+    const int col = static_cast<int>(d.N.cols() + i);
+    r.change = sel.joint.coef(col);
+    r.stddev = std::sqrt(std::max(0.0, sel.joint.cov(col, col)));
+    r.value = effectValue(in.base, r.effect) + r.change;
+    r.significance = r.stddev > 0 ? std::fabs(r.change) / r.stddev : 0;
+    r.lr = st.chosen.lr;
+    r.lm = st.chosen.lm;
+    r.p = st.chosen.p;
+    r.delta_bic = st.chosen.delta_bic;
+    r.holm_threshold = st.holm_threshold;
+    r.absorbed = st.chosen.absorbed;
+    r.absorbed_by_alignment = absorbedFraction(d.A, d.C.col(k));
+    r.vif = sel.joint_vif.size() ? sel.joint_vif(i) : 1.0;
+    for (size_t j = 0; j < st.confounded.size(); ++j) {
+      const Effect other = cands[st.confounded[j]];
+      r.confounded_with.push_back(effectName(other));
+      std::ostringstream s;
+      s << "The data cannot separate " << r.name << " from " << effectName(other)
+        << " (correlation of their orthogonalised signatures " << st.confounded_corr[j]
+        << "): " << separatingDrive(r.effect, other);
+      rep.notes.push_back(s.str());
+    }
+    if (r.effect == Effect::MotionDistortion) {
+      fitted.motion_distortion = r.change > 0.5;
+    } else {
+      fitted = withEffect(fitted, r.effect, r.change);
+    }
+    rep.effects.push_back(r);
+  }
+  // Pairs that are confounded although neither was selected still limit what a null means.
+  for (size_t a = 0; a < cands.size(); ++a)
+    for (size_t b = a + 1; b < cands.size(); ++b)
+      if (std::fabs(sel.corr(a, b)) > so.corr_max) {
+        bool said = false;
+        for (const auto& r : rep.effects)
+          if (r.effect == cands[a] || r.effect == cands[b]) said = true;
+        if (said) continue;
+        std::ostringstream s;
+        s << effectName(cands[a]) << " and " << effectName(cands[b])
+          << " have nearly identical signatures in this data (correlation " << sel.corr(a, b)
+          << "); " << separatingDrive(cands[a], cands[b]);
+        rep.notes.push_back(s.str());
+      }
+  for (const auto& c : rep.candidates)
+    if (c.absorbed_by_alignment > 0.9)
+      rep.notes.push_back(effectName(c.effect) + ": " +
+                          std::to_string(int(std::lround(100 * c.absorbed_by_alignment))) +
+                          "% of its signature is absorbed by a per-scan rigid alignment, so a "
+                          "scan-matching comparison would not see it; it is visible here only "
+                          "because the trajectory is taken as truth.");
+  rep.mismatch_found = !rep.effects.empty();
+  rep.fitted = fitted;
+
+  // 5. Re-simulate with the effects added one at a time; residual statistics per step.
+  std::vector<bool> use(rep.obs.size());
+  for (size_t i = 0; i < rep.obs.size(); ++i) use[i] = rep.obs[i].inlier;
+  {
+    std::vector<double> r0, a0;
+    for (const auto& o : rep.obs) {
+      r0.push_back(o.e_r);
+      a0.push_back(o.e_az);
+    }
+    rep.before = stats(rep.obs, r0, a0, use, sweep);
+  }
+  rep.after = rep.before;
+  if (opt.resimulate_after && !rep.effects.empty()) {
+    sim::PhysicsConfig ph = in.base;
+    for (size_t j = 0; j < rep.effects.size(); ++j) {
+      const EffectResult& r = rep.effects[j];
+      ph = r.effect == Effect::MotionDistortion ? withEffect(ph, r.effect, r.change > 0.5 ? 1 : 0)
+                                                : withEffect(ph, r.effect, r.change);
+      sim::Simulator s(in.world, in.trajectory, in.sensor, ph, opt.seed);
+      std::vector<double> er_j(rep.obs.size(), NAN), ea_j(rep.obs.size(), NAN);
+      for (size_t k = 0; k < in.scans.size(); ++k) {
+        std::vector<const Observation*> ptrs;
+        std::vector<Gate> gates;
+        for (int i : obs_of_scan[k]) {
+          ptrs.push_back(&rep.obs[i]);
+          gates.push_back(gate_of_obs[i]);
+        }
+        if (ptrs.empty()) continue;
+        const auto m = measureSimulated(s, in.scans[k], geos[k], ptrs, gates, in, opt);
+        for (size_t q = 0; q < ptrs.size(); ++q) {
+          if (!m[q].ok) continue;
+          const int i = obs_of_scan[k][q];
+          er_j[i] = rep.obs[i].real_r - m[q].range;
+          ea_j[i] = wrapPi(rep.obs[i].real_az - m[q].azimuth);
+        }
+      }
+      // Observations the re-simulation lost count with their base residual (conservative).
+      std::vector<double> er_s = er_j, ea_s = ea_j;
+      for (size_t i = 0; i < er_s.size(); ++i)
+        if (!std::isfinite(er_s[i])) {
+          er_s[i] = rep.obs[i].e_r;
+          ea_s[i] = rep.obs[i].e_az;
+        }
+      rep.after_step.push_back(stats(rep.obs, er_s, ea_s, use, sweep));
+      const ResidualStats& before = j == 0 ? rep.before : rep.after_step[j - 1];
+      EffectResult& rj = rep.effects[j];
+      rj.residual_rms_before = before.position_rms;
+      rj.residual_rms_after = rep.after_step.back().position_rms;
+      rj.range_rms_before = before.range_rms;
+      rj.range_rms_after = rep.after_step.back().range_rms;
+      rj.azimuth_rms_before = before.azimuth_rms;
+      rj.azimuth_rms_after = rep.after_step.back().azimuth_rms;
+      rep.after_e_r.push_back(er_j);
+      rep.after_e_az.push_back(ea_j);
+    }
+    rep.after = rep.after_step.back();
+  } else {
+    // No re-simulation: the linear model's residuals stand in for the "after" figures.
+    std::vector<double> fr, fa;
+    for (const auto& o : rep.obs) {
+      fr.push_back(o.fit_r);
+      fa.push_back(o.fit_az);
+    }
+    rep.after = stats(rep.obs, fr, fa, use, sweep);
+    for (auto& r : rep.effects) {
+      r.residual_rms_before = rep.before.position_rms;
+      r.residual_rms_after = rep.after.position_rms;
+    }
+  }
+  rep.locate = locateResiduals(rep.obs, false);
+  rep.runtime_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return rep;
+}
+
+}  // namespace spinradar::diagnose
