@@ -100,6 +100,23 @@ Design buildDesign(const std::vector<Observation>& obs, const std::vector<Effect
   return d;
 }
 
+// Noise scale of one residual type: the larger of the MAD and the RMS of the central 90 %
+// (the MAD collapses when most residuals are exactly equal, as with noise-free peaks), with a
+// floor at the precision a parabolic peak fit can claim (1/50 of a bin or of a row).
+double noiseScale(const std::vector<double>& v, double floor) {
+  if (v.empty()) return floor;
+  std::vector<double> a = v;
+  std::sort(a.begin(), a.end());
+  const size_t lo = a.size() / 20, hi = a.size() - a.size() / 20;
+  double mean = 0, n = 0;
+  for (size_t i = lo; i < hi; ++i, ++n) mean += a[i];
+  mean /= std::max(1.0, n);
+  double ss = 0;
+  for (size_t i = lo; i < hi; ++i) ss += (a[i] - mean) * (a[i] - mean);
+  const double trimmed = std::sqrt(ss / std::max(1.0, n));
+  return std::max({robustSigma(v), trimmed, floor});
+}
+
 }  // namespace
 
 double Observation::radialVelocity() const {
@@ -202,7 +219,9 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
     er.push_back(o.e_r);
     eaz.push_back(o.e_az);
   }
-  double sr = std::max(robustSigma(er), 1e-4), sa = std::max(robustSigma(eaz), 1e-5);
+  const double floor_r = 0.02 * in.sensor.range_resolution;
+  const double floor_a = 0.02 * 2.0 * M_PI / in.sensor.azimuths;
+  double sr = noiseScale(er, floor_r), sa = noiseScale(eaz, floor_a);
   {
     std::vector<double> a = er, b = eaz;
     std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
@@ -236,8 +255,8 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
       }
     }
     if (pass == 1) break;
-    sr = std::max(robustSigma(rr), 1e-4);
-    sa = std::max(robustSigma(ra), 1e-5);
+    sr = noiseScale(rr, floor_r);
+    sa = noiseScale(ra, floor_a);
     for (auto& o : rep.obs)
       o.inlier = std::fabs(o.fit_r) < opt.outlier_sigma * sr &&
                  std::fabs(o.fit_az) < opt.outlier_sigma * sa;

@@ -22,7 +22,17 @@ struct Case {
   uint64_t seed;
   const char* expect;     // effect name, or "" for the null case
   double value;
+  bool noisy = false;     // weak returns: noise floor raised so peaks carry real noise
 };
+
+// A sensor whose noise floor sits 25-45 dB below the target peaks (instead of ~70 dB), so the
+// measured peak positions scatter by a fraction of a bin / row from scan to scan.
+sim::SensorConfig noisySensor() {
+  sim::SensorConfig s = smallSensor();
+  s.noise_floor_db = 68.0;
+  s.clutter_db = 0.0;
+  return s;
+}
 
 Drive walking() {  // 1.5 m/s, a gentle left then right curve, a stop-and-go
   return {{{1.0, 1.5, 0.0}, {2.0, 1.5, 0.15}, {1.0, 0.6, 0.0}, {2.0, 1.5, -0.15}}, {0, 0, 0.3}};
@@ -42,7 +52,7 @@ TEST_P(Concealed, NamesAndFitsTheHiddenEffect) {
   const Case& c = GetParam();
   const sim::World world = randomWorld(c.seed, 90, 55.0, c.seed % 2 == 0);
   DiagnoseInput in = makeInput(world, c.drive, sim::PhysicsConfig::fromJson(c.hidden), c.scans,
-                               c.seed);
+                               c.seed, c.noisy ? noisySensor() : smallSensor());
   DiagnoseOptions opt;
   const DiagnoseReport rep = spinradar::diagnose::diagnose(in, opt);
   std::cout << c.name << ": " << rep.obs.size() << " obs, sigma_r " << rep.sigma_r
@@ -81,7 +91,15 @@ INSTANTIATE_TEST_SUITE_P(Diagnose, Concealed, ::testing::Values(
   Case{"range_offset_small", {{"range_offset", 0.08}}, walking(), 4, 30, "range_offset", 0.08},
   Case{"null_walking", nlohmann::json::object(), walking(), 6, 21, "", 0},
   Case{"null_turning", nlohmann::json::object(), turning(), 5, 22, "", 0},
-  Case{"null_straight", nlohmann::json::object(), straight(), 4, 23, "", 0}),
+  Case{"null_straight", nlohmann::json::object(), straight(), 4, 23, "", 0},
+  Case{"noisy_doppler_walking", {{"doppler", 0.049}}, walking(), 8, 51, "doppler", 0.049, true},
+  Case{"noisy_motion_distortion", {{"motion_distortion", true}}, straight(), 4, 52, "motion_distortion", 1.0, true},
+  Case{"noisy_latency_35ms", {{"timestamp_offset", 0.035}}, turning(), 5, 53, "timestamp_offset", 0.035, true},
+  Case{"noisy_azimuth_offset", {{"azimuth_offset", 0.008}}, turning(), 4, 54, "azimuth_offset", 0.008, true},
+  Case{"noisy_range_offset", {{"range_offset", -0.3}}, walking(), 4, 55, "range_offset", -0.3, true},
+  Case{"noisy_null_walking", nlohmann::json::object(), walking(), 8, 56, "", 0, true},
+  Case{"noisy_null_turning", nlohmann::json::object(), turning(), 5, 57, "", 0, true},
+  Case{"noisy_null_straight", nlohmann::json::object(), straight(), 4, 58, "", 0, true}),
   [](const ::testing::TestParamInfo<Case>& i) { return std::string(i.param.name); });
 // clang-format on
 
