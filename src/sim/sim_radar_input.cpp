@@ -4,6 +4,8 @@
 #include <cmath>
 #include <thread>
 
+#include "spinradar/sim/scenes.hpp"
+
 namespace spinradar::sim {
 
 using navtech::InputStatus;
@@ -68,6 +70,14 @@ InputStatus SimRadarInput::readSome(std::vector<uint8_t>& chunk, int64_t& receiv
   receive_ns = stamp;
   ++row_;
   return InputStatus::Ok;
+}
+
+std::shared_ptr<const Simulator> makeBuiltinSimulator(const std::string& scene,
+                                                      const PhysicsConfig& physics, uint64_t seed,
+                                                      double t0) {
+  Scene s = builtinScene(scene, 0, t0);
+  return std::make_shared<const Simulator>(std::move(s.world), std::move(s.trajectory),
+                                           SensorConfig{}, physics, seed);
 }
 
 std::unique_ptr<navtech::RadarInput> makeSimInput(std::shared_ptr<const Simulator> sim,

@@ -4,6 +4,7 @@
 // directly by the driver (SimRadarInput) or served on a loopback port (simScanSource +
 // navtech::NavtechServer, `spinradar serve`).
 #include <memory>
+#include <string>
 
 #include "spinradar/core/navtech_server.hpp"
 #include "spinradar/core/radar_input.hpp"
@@ -45,6 +46,13 @@ class SimRadarInput : public navtech::ByteStreamInput {
 
 std::unique_ptr<navtech::RadarInput> makeSimInput(std::shared_ptr<const Simulator> sim,
                                                   SimInputOptions options = {});
+
+/// A simulator of a built-in scene (spinradar/sim/scenes.hpp: city, out_and_back,
+/// tight_turns) with the default CIR204-H sensor. Throws std::invalid_argument for an unknown
+/// scene, listing the valid names.
+std::shared_ptr<const Simulator> makeBuiltinSimulator(const std::string& scene,
+                                                      const PhysicsConfig& physics,
+                                                      uint64_t seed = 1, double t0 = 0.0);
 
 /// Scans for NavtechServer, in order from `first_scan`. With `loop`, starts over at the end
 /// with stamps shifted by the trajectory's duration so time keeps increasing.
