@@ -45,3 +45,13 @@ if(SPINRADAR_FUZZ_OK)
 else()
   message(STATUS "spinradar: clang with libFuzzer not found: fuzz_navtech_stream skipped")
 endif()
+
+# ROS conversions of the driver's scans (plain gtest, no roscore needed).
+if(TARGET spinradar_nodelets AND EXISTS ${PROJECT_SOURCE_DIR}/test/ros/test_navtech_conversions.cpp)
+  add_executable(ros_test_navtech_conversions ${PROJECT_SOURCE_DIR}/test/ros/test_navtech_conversions.cpp)
+  target_link_libraries(ros_test_navtech_conversions PRIVATE spinradar_nodelets ${SPINRADAR_GTEST}
+    Threads::Threads)
+  add_dependencies(ros_test_navtech_conversions ${PROJECT_NAME}_generate_messages_cpp)
+  gtest_discover_tests(ros_test_navtech_conversions DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
+    WORKING_DIRECTORY ${CMAKE_BINARY_DIR} PROPERTIES TIMEOUT 120)
+endif()
