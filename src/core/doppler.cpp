@@ -35,10 +35,10 @@ bool estimateMcDoppler(McRansac& mc, const std::vector<Keypoint>& k1,
     const Eigen::Vector3d before = out.velocity;
     dopplerCorrect(k1, out.velocity, beta, k1c);
     dopplerCorrect(k2, out.velocity, beta, k2c);
-    if (!mc.refit(k1c, k2c, matches, ref1_ns, ref2_ns, out)) return false;
+    if (!mc.refit(k1c, k2c, matches, ref1_ns, ref2_ns, out, false)) return false;
     if ((out.velocity - before).head<2>().norm() < kDopplerTolerance) break;
   }
-  return true;
+  return out.ok = mc.updateCovariance(ref1_ns, ref2_ns, out);
 }
 
 }  // namespace spinradar

@@ -273,13 +273,14 @@ bool McRansac::estimate(const std::vector<Keypoint>& k1, const std::vector<Keypo
 
 bool McRansac::refit(const std::vector<Keypoint>& k1, const std::vector<Keypoint>& k2,
                      const std::vector<Match>& matches, int64_t ref1_ns, int64_t ref2_ns,
-                     MotionEstimate& inout) {
+                     MotionEstimate& inout, bool with_covariance) {
   load(k1, k2, matches);
   const double dt_ref = 1e-9 * static_cast<double>(ref2_ns - ref1_ns);
   if (inout.inliers.size() < 2 || !(dt_ref > 0.0)) return inout.ok = false;
   work_.assign(inout.inliers.begin(), inout.inliers.end());
   const Eigen::Vector3d start = -inout.velocity;
-  if (!finish(start, work_, dt_ref, inout) || !covariance(work_, dt_ref, inout))
+  if (!finish(start, work_, dt_ref, inout) ||
+      (with_covariance && !covariance(work_, dt_ref, inout)))
     return inout.ok = false;
   // The refit ran on the given set; report the inliers of the refined velocity.
   selectInliers(-inout.velocity, &best_);
@@ -288,6 +289,12 @@ bool McRansac::refit(const std::vector<Keypoint>& k1, const std::vector<Keypoint
   inout.matches = static_cast<int>(matches.size());
   inout.ok = true;
   return true;
+}
+
+bool McRansac::updateCovariance(int64_t ref1_ns, int64_t ref2_ns, MotionEstimate& inout) const {
+  const double dt_ref = 1e-9 * static_cast<double>(ref2_ns - ref1_ns);
+  if (inout.inliers.size() < 2 || !(dt_ref > 0.0)) return false;
+  return covariance(inout.inliers, dt_ref, inout);
 }
 
 }  // namespace spinradar

@@ -57,7 +57,11 @@ class McRansac {
   /// keypoints have been changed (Doppler correction). Returns inout.ok.
   bool refit(const std::vector<Keypoint>& k1, const std::vector<Keypoint>& k2,
              const std::vector<Match>& matches, int64_t ref1_ns, int64_t ref2_ns,
-             MotionEstimate& inout);
+             MotionEstimate& inout, bool with_covariance = true);
+
+  /// Recomputes inout's covariances on inout.inliers for the matches of the last
+  /// estimate/refit call (after refit(..., false)).
+  bool updateCovariance(int64_t ref1_ns, int64_t ref2_ns, MotionEstimate& inout) const;
 
   /// Number of Gauss-Newton steps per 2-point hypothesis: from varpi = 0 the residual of a
   /// scan pair at 30 m/s and 1 rad/s drops below 1e-6 m in three.
