@@ -11,6 +11,7 @@
 #include "spinradar/core/lie.hpp"
 #include "spinradar/core/matcher.hpp"
 #include "spinradar/core/mc_ransac.hpp"
+#include "spinradar/core/refined_estimator.hpp"
 #include "spinradar/core/rigid_ransac.hpp"
 #include "spinradar/core/undistort.hpp"
 
@@ -24,8 +25,7 @@ Estimator parseEstimator(const std::string& name) {
   if (name == "rigid") return Estimator::kRigid;
   if (name == "mc") return Estimator::kMc;
   if (name == "mc_doppler") return Estimator::kMcDoppler;
-  if (name == "refined")
-    throw std::invalid_argument("parameter 'estimator': 'refined' is not implemented yet");
+  if (name == "refined") return Estimator::kRefined;
   throw std::invalid_argument("parameter 'estimator': unknown value '" + name + "'");
 }
 
@@ -63,6 +63,7 @@ struct Odometry::Impl {
   std::unique_ptr<FeatureExtractor> extractor;  ///< created on the first polar scan
   RigidRansac rigid;
   McRansac mc;
+  RefinedEstimator refined;
 
   FrameBuffer prev, cur;
   bool has_prev = false;
@@ -84,6 +85,7 @@ struct Odometry::Impl {
     estimator = parseEstimator(c.estimator.estimator);
     rigid.setConfig(c.estimator);
     mc.setConfig(c.estimator);
+    refined.setConfig(c.estimator);
     if (features_changed) extractor.reset();  // rebuilt with the new settings on demand
   }
 
@@ -110,6 +112,7 @@ struct Odometry::Impl {
     has_last = false;
     T_world.setIdentity();
     pose_cov.setZero();
+    refined.reset();
     corrected.clear();
     raw.clear();
   }
@@ -126,7 +129,7 @@ struct Odometry::Impl {
         return estimateMcDoppler(mc, a.keypoints, b.keypoints, matches, a.stamp_ns, b.stamp_ns,
                                  config.estimator.beta, corr1, corr2, m);
       case Estimator::kRefined:
-        return false;  // rejected by parseEstimator
+        return refined.estimate(a, b, matches, corr1, corr2, m);
     }
     return false;
   }
