@@ -326,6 +326,33 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
     }
     rep.effects.push_back(r);
   }
+  // Range residuals alone (what a range-only or scan-to-scan comparison sees): pairs that only
+  // the azimuth residuals tell apart are worth a note, since real azimuths are less precise.
+  {
+    const int m = static_cast<int>(d.y.size() / 2);
+    const Eigen::MatrixXd Cr = d.C.topRows(m);
+    for (size_t i = 0; i < rep.effects.size(); ++i) {
+      const int k = sel.selected[i];
+      const Eigen::VectorXd xk = Cr.col(k);
+      for (size_t j = 0; j < cands.size(); ++j) {
+        if (static_cast<int>(j) == k) continue;
+        const auto& cw = rep.effects[i].confounded_with;
+        if (std::find(cw.begin(), cw.end(), effectName(cands[j])) != cw.end()) continue;
+        const Eigen::VectorXd xj = Cr.col(j);
+        const double na = xk.norm(), nb = xj.norm();
+        if (na <= 0 || nb <= 0) continue;
+        const double c = xk.dot(xj) / (na * nb);
+        if (std::fabs(c) <= so.corr_max) continue;
+        std::ostringstream s;
+        s << "In the range residuals alone " << rep.effects[i].name << " and "
+          << effectName(cands[j]) << " cannot be told apart (correlation " << c
+          << "); here the azimuth (tangential) residuals separate them (joint correlation "
+          << sel.corr(k, j) << "). With less precise azimuths: "
+          << separatingDrive(rep.effects[i].effect, cands[j]);
+        rep.notes.push_back(s.str());
+      }
+    }
+  }
   // Pairs that are confounded although neither was selected still limit what a null means.
   for (size_t a = 0; a < cands.size(); ++a)
     for (size_t b = a + 1; b < cands.size(); ++b)
