@@ -413,15 +413,37 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
           ea_j[i] = wrapPi(rep.obs[i].real_az - m[q].azimuth);
         }
       }
-      // Observations the re-simulation lost count with their base residual (conservative).
-      std::vector<double> er_s = er_j, ea_s = ea_j;
-      for (size_t i = 0; i < er_s.size(); ++i)
+      // Observations the re-simulation lost count with their base residual (conservative);
+      // peaks that jumped to another return (beyond outlier_sigma of this step's robust
+      // scale) are left out of this step's before and after figures alike.
+      std::vector<double> er_s = er_j, ea_s = ea_j, rr, ra;
+      for (size_t i = 0; i < er_s.size(); ++i) {
         if (!std::isfinite(er_s[i])) {
           er_s[i] = rep.obs[i].e_r;
           ea_s[i] = rep.obs[i].e_az;
         }
-      rep.after_step.push_back(stats(rep.obs, er_s, ea_s, use, sweep));
-      const ResidualStats& before = j == 0 ? rep.before : rep.after_step[j - 1];
+        if (use[i]) {
+          rr.push_back(er_s[i]);
+          ra.push_back(ea_s[i]);
+        }
+      }
+      const double sr_j = noiseScale(rr, floor_r), sa_j = noiseScale(ra, floor_a);
+      std::vector<bool> use_j = use;
+      for (size_t i = 0; i < er_s.size(); ++i)
+        if (std::fabs(er_s[i]) > opt.outlier_sigma * sr_j ||
+            std::fabs(ea_s[i]) > opt.outlier_sigma * sa_j)
+          use_j[i] = false;
+      rep.after_step.push_back(stats(rep.obs, er_s, ea_s, use_j, sweep));
+      std::vector<double> prev_r, prev_a;
+      for (size_t i = 0; i < rep.obs.size(); ++i) {
+        prev_r.push_back(j == 0 ? rep.obs[i].e_r : rep.after_e_r[j - 1][i]);
+        prev_a.push_back(j == 0 ? rep.obs[i].e_az : rep.after_e_az[j - 1][i]);
+        if (!std::isfinite(prev_r.back())) {
+          prev_r.back() = rep.obs[i].e_r;
+          prev_a.back() = rep.obs[i].e_az;
+        }
+      }
+      const ResidualStats before = stats(rep.obs, prev_r, prev_a, use_j, sweep);
       EffectResult& rj = rep.effects[j];
       rj.residual_rms_before = before.position_rms;
       rj.residual_rms_after = rep.after_step.back().position_rms;

@@ -25,11 +25,12 @@ struct Case {
   bool noisy = false;     // weak returns: noise floor raised so peaks carry real noise
 };
 
-// A sensor whose noise floor sits 25-45 dB below the target peaks (instead of ~70 dB), so the
-// measured peak positions scatter by a fraction of a bin / row from scan to scan.
+// A sensor whose noise floor sits about 15-30 dB below the target peaks, so the measured peak
+// positions scatter by a fraction of a bin / row from scan to scan (set relative to the radar
+// constant so it follows the simulator's calibration).
 sim::SensorConfig noisySensor() {
   sim::SensorConfig s = smallSensor();
-  s.noise_floor_db = 68.0;
+  s.noise_floor_db = s.radar_constant_db - 28.0;
   s.clutter_db = 0.0;
   return s;
 }
