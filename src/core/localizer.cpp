@@ -123,8 +123,13 @@ int Localizer::loadMap(const std::string& scan_dir, const std::string& poses_csv
   if (poses.size() < 2) throw std::runtime_error(poses_csv + ": fewer than 2 map poses");
   std::vector<LocFrame> frames;
   frames.reserve(folder.size());
+  // File stamps are within a rotation of the reference time: skip scans clearly outside the
+  // poses before paying for their detection.
+  const double t_lo = poses.front().t - 1.0, t_hi = poses.back().t + 1.0;
   for (size_t i = 0; i < folder.size(); ++i) {
     if (progress) progress(i, folder.size());
+    const double t_file = 1e-9 * static_cast<double>(folder.fileStampNs(i));
+    if (t_file < t_lo || t_file > t_hi) continue;
     LocFrame f;
     prepare(folder.load(i), f);
     PoseRecord p;
