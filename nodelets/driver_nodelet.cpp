@@ -38,6 +38,7 @@ class DriverNodelet : public nodelet::Nodelet {
     if (config_.input == "sim") {
       spinradar::sim::SimInputOptions o;
       o.rate = config_.sim_rate;
+      o.wall_clock = config_.sim_rate > 0;  // real-time runs look like a live sensor
       input = spinradar::sim::makeSimInput(
           spinradar::sim::makeBuiltinSimulator(config_.sim_scene, spinradar::sim::PhysicsConfig{}), o);
     } else {

@@ -55,3 +55,16 @@ if(TARGET spinradar_nodelets AND EXISTS ${PROJECT_SOURCE_DIR}/test/ros/test_navt
   gtest_discover_tests(ros_test_navtech_conversions DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
     WORKING_DIRECTORY ${CMAKE_BINARY_DIR} PROPERTIES TIMEOUT 120)
 endif()
+
+# rostest: the DriverNodelet against `spinradar serve` on loopback (test/ros/driver.test).
+if(TARGET spinradar_nodelets AND CATKIN_ENABLE_TESTING)
+  find_package(rostest QUIET)
+  if(rostest_FOUND)
+    add_rostest_gtest(ros_test_driver_nodelet test/ros/driver.test test/ros/test_driver_nodelet.cpp)
+    target_include_directories(ros_test_driver_nodelet PRIVATE
+      ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION} ${catkin_INCLUDE_DIRS})
+    target_link_libraries(ros_test_driver_nodelet ${catkin_LIBRARIES})
+    add_dependencies(ros_test_driver_nodelet ${PROJECT_NAME}_generate_messages_cpp spinradar_nodelets
+      spinradar_cli)
+  endif()
+endif()

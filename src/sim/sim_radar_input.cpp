@@ -43,7 +43,11 @@ InputStatus SimRadarInput::readSome(std::vector<uint8_t>& chunk, int64_t& receiv
     scan_ = sim_->renderScan(next_scan_++);
     row_ = 0;
   }
-  const int64_t stamp = scan_.stamp_ns[row_];
+  if (opt_.wall_clock && !offset_set_) {
+    offset_ns_ = navtech::wallClockNs() - scan_.stamp_ns[row_];
+    offset_set_ = true;
+  }
+  const int64_t stamp = scan_.stamp_ns[row_] + offset_ns_;
   if (opt_.rate > 0) {
     if (!started_) {
       first_stamp_ = stamp;

@@ -26,7 +26,7 @@
   X(double, capture_rate, 0.0, 0.0, 1000.0, "x", "Replay speed of a capture: 1 = real time, 0 = as fast as possible") \
   X(std::string, record_file, "", 0, 0, "", "Also record the raw TCP stream to this capture file (input socket)") \
   X(std::string, sim_scene, "city", 0, 0, "", "Built-in simulator scene (input sim)") \
-  X(double, sim_rate, 1.0, 0.0, 1000.0, "x", "Simulator speed: 1 = real time, 0 = as fast as possible (input sim)") \
+  X(double, sim_rate, 1.0, 0.0, 1000.0, "x", "Simulator speed: 1 = real time (stamps then follow the wall clock), 0 = as fast as possible with the simulator clock (input sim)") \
   X(bool, publish_image, false, 0, 0, "", "Also publish the Oxford-layout mono8 image (CFEAR, Boreas tools)")
 // clang-format on
 

@@ -17,10 +17,11 @@ struct SimInputOptions {
   int first_scan = 0;
   int n_scans = -1;    ///< -1: every whole rotation of the trajectory
   int bit_depth = 8;   ///< 16: type-31 messages with value = power * 256
+  bool wall_clock = false;  ///< shift stamps so the first azimuth is "now" (like a live sensor)
 };
 
-/// Receive stamps equal the simulated acquisition stamps (a perfect network), so runs are
-/// deterministic whatever the rate.
+/// Receive stamps equal the (possibly wall-clock shifted) acquisition stamps (a perfect
+/// network), so runs without wall_clock are deterministic whatever the rate.
 class SimRadarInput : public navtech::ByteStreamInput {
  public:
   SimRadarInput(std::shared_ptr<const Simulator> sim, SimInputOptions options = {});
@@ -40,6 +41,8 @@ class SimRadarInput : public navtech::ByteStreamInput {
   bool sent_config_ = false;
   std::vector<uint16_t> bins16_;
   int64_t first_stamp_ = 0;
+  int64_t offset_ns_ = 0;
+  bool offset_set_ = false;
   bool started_ = false;
   std::chrono::steady_clock::time_point start_{};
 };
