@@ -135,7 +135,9 @@ void encodeRows(const PolarScan& scan, cv::Mat& img, bool chirp_column) {
     throw std::runtime_error("cannot encode scan: power has " + std::to_string(scan.power.size()) +
                              " values, azimuths x bins expected");
   img.create(scan.azimuths, scan.bins + kNavtechMetaColumns, CV_8UC1);
-  const bool have_enc = scan.encoder.size() == static_cast<size_t>(scan.azimuths);
+  // The layout has no field for the encoder size: it is always 5600. Other sensors' encoders are
+  // rewritten from the angles so that the file still reads back with the right angles.
+  const bool have_enc = scan.encoder.size() == static_cast<size_t>(scan.azimuths) && scan.encoder_size == 5600;
   for (int a = 0; a < scan.azimuths; ++a) {
     uint8_t* p = img.ptr<uint8_t>(a);
     const int64_t ns = a < static_cast<int>(scan.stamp_ns.size()) ? scan.stamp_ns[a] : 0;
@@ -145,8 +147,7 @@ void encodeRows(const PolarScan& scan, cv::Mat& img, bool chirp_column) {
       enc = scan.encoder[a];
     } else if (a < static_cast<int>(scan.azimuth.size())) {
       const double turns = scan.azimuth[a] / (2.0 * M_PI);
-      enc = static_cast<int>(std::lround((turns - std::floor(turns)) * scan.encoder_size)) %
-            scan.encoder_size;
+      enc = static_cast<int>(std::lround((turns - std::floor(turns)) * 5600.0)) % 5600;
     }
     p[8] = static_cast<uint8_t>(enc & 0xff);
     p[9] = static_cast<uint8_t>((enc >> 8) & 0xff);

@@ -93,6 +93,20 @@ TEST(ScanIo, OxfordRoundTrip) {
   EXPECT_EQ(decodeOxfordImage(img, "mem").power, s.power);
 }
 
+TEST(ScanIo, OtherEncoderSizesAreWrittenAsAnglesOf5600) {
+  TempDir d;
+  PolarScan s = makeScan(400, 20, 1000);
+  s.encoder_size = 4000;
+  for (int a = 0; a < 400; ++a) {
+    s.encoder[a] = static_cast<uint16_t>(a * 10);
+    s.azimuth[a] = 2 * M_PI * a / 400.0;
+  }
+  saveOxfordPng(s, d.file("e.png"));
+  const PolarScan r = loadOxfordPng(d.file("e.png"));
+  for (int a = 0; a < 400; ++a) EXPECT_NEAR(r.azimuth[a], s.azimuth[a], 1e-12) << a;
+  EXPECT_EQ(r.encoder[1], 14);
+}
+
 TEST(ScanIo, BoreasRoundTripBothFirmwaresAndChirps) {
   TempDir d;
   for (int bins : {3360, 6848}) {
