@@ -158,7 +158,7 @@ void CartesianProjector::remapRows(uint8_t* image, size_t image_step) const {
   const uint8_t* wt = weight_table_.data();
 #if defined(__GNUC__) && defined(__x86_64__)
   static const bool avx2 = cpuHasAvx2();
-  if (avx2) {
+  if (avx2 && use_simd_) {
     for (int v = 0; v < width_; ++v)
       remapAvx2(pol, bins, off + size_t(v) * width_, wt + size_t(v) * width_, image + v * image_step, width_);
     return;

@@ -1,6 +1,8 @@
 // The Cartesian image puts a return at (r, phi) at the right pixel; tables are cached.
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include <opencv2/core.hpp>
 
 #include "spinradar/core/cartesian.hpp"
@@ -144,4 +146,18 @@ TEST(Cartesian, InvalidRowsDoNotLeaveGapsAndFarPixelsAreBlack) {
       }
     }
   EXPECT_GT(inside, 70000);
+}
+
+TEST(Cartesian, SimdAndPortableRemapAgree) {
+  PolarScan s = emptyScan();
+  std::mt19937 rng(2);
+  std::uniform_int_distribution<int> u(0, 255);
+  for (auto& p : s.power) p = static_cast<uint8_t>(u(rng));
+  s.valid[100] = 0;
+  CartesianProjector simd, portable;
+  portable.setUseSimd(false);
+  cv::Mat a, b;
+  simd.render(s, a);
+  portable.render(s, b);
+  EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
 }

@@ -43,6 +43,10 @@ class CartesianProjector {
     return {(centre_ - px.y) * resolution_, (centre_ - px.x) * resolution_};
   }
 
+  /// Lets the remap use AVX2 gathers when the CPU has them (default). Off = portable loop;
+  /// both give identical images (the switch exists so tests cover both paths).
+  void setUseSimd(bool use) { use_simd_ = use; }
+
   double resolution() const { return resolution_; }
   int width() const { return width_; }
   int tableBuilds() const { return builds_; }  ///< how many times the remap tables were built
@@ -57,6 +61,7 @@ class CartesianProjector {
   int width_ = 964;
   double centre_ = 481.5;
   int builds_ = 0;
+  bool use_simd_ = true;
   // geometry the tables were built for
   int azimuths_ = -1, bins_ = -1;
   double range_resolution_ = 0, offset_ = 0;
