@@ -17,4 +17,8 @@ void matchScalar(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<
 /// Returns false (and does nothing) when the CPU lacks the instructions. Appends to `out`.
 bool matchAvx512(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Match>& out);
 
+/// AVX2 kernel for 32-byte descriptors (nibble-table popcount, four train rows per register).
+/// Returns false (and does nothing) when the CPU lacks AVX2. Appends to `out`.
+bool matchAvx2(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Match>& out);
+
 }  // namespace spinradar::detail
