@@ -91,6 +91,8 @@ TEST(Rsd, RangeHistogramIsRotationInvariant) {
   // Arbitrary angle: only rasterisation changes the histograms, so they stay close.
   RsdConfig cfg;
   cfg.rsd_slices = 0;
+  cfg.rsd_radius = 40.0;  // fixed here: the test is about invariance, not the defaults
+  cfg.rsd_rings = 20;
   RsdExtractor rsd(cfg);
   const auto pts = makeCloud(400, 2);
   const auto rot = transformed(pts, 0.6435, Eigen::Vector2d::Zero());

@@ -34,7 +34,7 @@
 // clang-format off
 #define SPINRADAR_LOCALIZER_PARAMS(X) \
   X(std::string, compensation, "motion_doppler", 0, 0, "", "Localization compensation: none, motion or motion_doppler") \
-  X(double, loc_nndr, 0.9, 0.1, 1.0, "", "RSD nearest-neighbour distance ratio against the map scan") \
+  X(double, loc_nndr, 0.95, 0.1, 1.0, "", "RSD nearest-neighbour distance ratio against the map scan") \
   X(int, loc_ransac_iterations, 1000, 1, 100000, "", "Rigid RANSAC iterations against the map scan") \
   X(double, loc_inlier_threshold, 0.35, 0.01, 5.0, "m", "Rigid RANSAC inlier threshold against the map scan") \
   X(int, loc_min_inliers, 8, 2, 100000, "", "Fewer RANSAC inliers than this: the scan is not localised") \

@@ -29,7 +29,7 @@
 // clang-format off
 #define SPINRADAR_RSD_PARAMS(X) \
   X(double, rsd_resolution, 0.25, 0.05, 5.0, "m/px", "RSD binary keypoint grid resolution") \
-  X(double, rsd_radius, 40.0, 2.0, 200.0, "m", "RSD neighbourhood radius around each keypoint") \
+  X(double, rsd_radius, 20.0, 2.0, 200.0, "m", "RSD neighbourhood radius around each keypoint") \
   X(int, rsd_rings, 20, 2, 64, "", "RSD range rings (bins of the range histogram)") \
   X(int, rsd_slices, 16, 0, 64, "", "RSD azimuth slices, even (0 = range histogram only)") \
   X(double, rsd_azimuth_weight, 0.5, 0.0, 10.0, "", "Weight of the azimuth-DFT part against the unit range histogram") \
