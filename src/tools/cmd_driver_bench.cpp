@@ -53,12 +53,14 @@ ScanSource benchSource(int azimuths, int bins) {
   };
 }
 
-void bench(const std::vector<double>& rates, double seconds, int azimuths, int bins) {
+void bench(const std::vector<double>& rates, double seconds, int azimuths, int bins, int depth) {
+  std::printf("%d-bit FFT data, %d x %d\n\n", depth, azimuths, bins);
   std::printf("| rate | azimuths/s | scans | driver CPU (%% of a core) | process CPU (%%) | latency median / p99 / max (ms) | missing azimuths |\n");
   std::printf("|---|---|---|---|---|---|---|\n");
   for (double rate : rates) {
     ServerOptions so;
     so.rate = rate;
+    so.bit_depth = depth;
     so.log = [](LogLevel, const std::string&) {};
     NavtechServer server(so, benchSource(azimuths, bins));
     server.start();
@@ -103,9 +105,13 @@ SPINRADAR_COMMAND("driver-bench", "Measure the Navtech driver's CPU use and late
                     auto seconds = std::make_shared<double>(5.0);
                     auto azimuths = std::make_shared<int>(400);
                     auto bins = std::make_shared<int>(3768);
+                    auto depth = std::make_shared<int>(8);
                     app.add_option("--rates", *rates, "Multiples of real time to measure")->capture_default_str();
                     app.add_option("--seconds", *seconds, "Measurement time per rate")->capture_default_str();
                     app.add_option("--azimuths", *azimuths, "Azimuths per rotation")->capture_default_str();
                     app.add_option("--bins", *bins, "Range bins per azimuth")->capture_default_str();
-                    app.callback([=] { bench(*rates, *seconds, *azimuths, *bins); });
+                    app.add_option("--bit-depth", *depth, "FFT data: 8 (type 30) or 16 (type 31)")
+                        ->check(CLI::IsMember({8, 16}))
+                        ->capture_default_str();
+                    app.callback([=] { bench(*rates, *seconds, *azimuths, *bins, *depth); });
                   });
