@@ -35,8 +35,25 @@ if(EXISTS ${PROJECT_SOURCE_DIR}/src/tools/cmd_odometry.cpp)
   add_test(NAME cli_odometry_bad_parameter
     COMMAND bash ${_tt}/expect_error.sh "zq"
             ${_cli} odometry --input ${_tt} --out ${_out}/never.csv --zq -3)
+  add_test(NAME cli_odometry_bad_config_key
+    COMMAND bash ${_tt}/expect_error.sh "error: .*bad_config.yaml:2: unknown parameter 'not_a_param'"
+            ${_cli} odometry --input ${_tt} --out ${_out}/never.csv --config ${_tt}/data/bad_config.yaml)
+  add_test(NAME cli_odometry_bad_option_value
+    COMMAND bash ${_tt}/expect_error.sh "error: option --ransac_iterations: parameter 'ransac_iterations': 'many' is not an integer"
+            ${_cli} odometry --input ${_tt} --out ${_out}/never.csv --ransac-iterations many)
   # Real data: the Oxford sample's consecutive-scan motion against the dataset's ground truth.
   add_test(NAME cli_odometry_oxford_sample
     COMMAND bash ${_tt}/oxford_odometry.sh ${_cli} ${SPINRADAR_SHARED_DIR} ${_out}/oxford)
   set_tests_properties(cli_odometry_oxford_sample PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 300)
+  # The grouped YAML form is accepted and overrides the defaults (estimator rigid -> log line).
+  add_test(NAME cli_odometry_grouped_config
+    COMMAND ${_cli} odometry --input ${SPINRADAR_SHARED_DIR}/realdata/oxford_2019-01-10-14-36-48
+            --out ${_out}/grouped.csv --quiet --config ${_tt}/data/grouped_config.yaml)
+  set_tests_properties(cli_odometry_grouped_config PROPERTIES
+    PASS_REGULAR_EXPRESSION "estimator rigid")
+  if(TARGET spinradar_bag)
+    add_test(NAME cli_bag_roundtrip
+      COMMAND bash ${_tt}/bag_roundtrip.sh ${_cli} ${SPINRADAR_SHARED_DIR} ${_out}/bag)
+    set_tests_properties(cli_bag_roundtrip PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 300)
+  endif()
 endif()
