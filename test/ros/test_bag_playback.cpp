@@ -57,7 +57,7 @@ TEST(BagPlayback, SameOdometryAsTheLiveRun) {
       << "playback odometry for only " << common.size() << " of " << live.size() << " live scans";
   double max_dt = 0, max_dr = 0;
   for (size_t k = 2; k < common.size(); ++k) {
-    auto rel = [&](const spinradar::PoseRecord& a, const spinradar::PoseRecord& b) {
+    auto rel = [](const spinradar::PoseRecord& a, const spinradar::PoseRecord& b) -> Eigen::Matrix3d {
       return spinradar::se2::inverse(spinradar::poseMatrix(a)) * spinradar::poseMatrix(b);
     };
     const Eigen::Matrix3d e = spinradar::se2::inverse(rel(live_by_stamp[common[k - 1]], live_by_stamp[common[k]])) *
