@@ -11,6 +11,7 @@
 #include "spinradar/core/doppler.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/core/mc_ransac.hpp"
+#include "spinradar/core/refined_estimator.hpp"
 #include "spinradar/core/rigid_ransac.hpp"
 
 using namespace spinradar;
@@ -147,7 +148,8 @@ TEST(McRansac, TimingPerScanPair) {
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return 1e3 * ts.tv_sec + 1e-6 * ts.tv_nsec;
   };
-  std::vector<double> t_mc, t_rg, t_md;
+  std::vector<double> t_mc, t_rg, t_md, t_rf;
+  RefinedEstimator refined;
   for (int rep = 0; rep < 31; ++rep) {
     const double a = cpu_ms();
     mc.estimate(p.f1.keypoints, p.f2.keypoints, p.matches, p.f1.stamp_ns, p.f2.stamp_ns, est);
@@ -157,13 +159,19 @@ TEST(McRansac, TimingPerScanPair) {
     estimateMcDoppler(mc, p.f1.keypoints, p.f2.keypoints, p.matches, p.f1.stamp_ns,
                       p.f2.stamp_ns, 0.049, c1, c2, est);
     const double d = cpu_ms();
+    refined.reset();
+    refined.estimate(p.f1, p.f2, p.matches, c1, c2, est);
+    const double e = cpu_ms();
+    t_rf.push_back(e - d);
     t_mc.push_back(b - a);
     t_rg.push_back(c - b);
     t_md.push_back(d - c);
   }
-  for (auto* v : {&t_mc, &t_rg, &t_md}) std::nth_element(v->begin(), v->begin() + 15, v->end());
+  for (auto* v : {&t_mc, &t_rg, &t_md, &t_rf})
+    std::nth_element(v->begin(), v->begin() + 15, v->end());
   std::cout << "[ info ] " << p.matches.size() << " matches, median CPU ms: MC-RANSAC " << t_mc[15]
-            << ", rigid RANSAC " << t_rg[15] << ", MC+Doppler " << t_md[15] << "\n";
+            << ", rigid RANSAC " << t_rg[15] << ", MC+Doppler " << t_md[15] << ", refined "
+            << t_rf[15] << "\n";
   EXPECT_TRUE(est.ok);
 }
 
