@@ -211,7 +211,7 @@ void toDebugImageMsg(const cv::Mat& cartesian, const spinradar::FeatureFrame& fr
   for (const auto& k : frame.keypoints) {
     const cv::Point p(static_cast<int>(std::lround(cu - k.y / resolution)),
                       static_cast<int>(std::lround(cv_ - k.x / resolution)));
-    cv::circle(out, p, 3, cv::Scalar(0, 0, 255), 1, cv::LINE_AA);
+    cv::circle(out, p, 2, cv::Scalar(0, 0, 255), 1, cv::LINE_AA);
   }
 }
 
