@@ -102,26 +102,59 @@ std::vector<TargetView> targetViews(int scan_index, const PolarScan& scan,
                               0.03 + 0.2 * w + 0.3 * speed / std::max(v.pred.range, 1.0));
     views.push_back(v);
   }
-  // Isolation: drop views whose gates could hold another target, a wall, or are shadowed.
+  // Isolation: a view is kept when it dominates its gate: every other return that could fall
+  // inside (targets, wall scatterers) is at least opt.dominance_db weaker, so the recorded and
+  // re-simulated peaks are the same scatterer (weaker neighbours shift both alike). Views are
+  // sorted by range so that only neighbours in range are compared.
+  std::vector<size_t> order(views.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](size_t x, size_t y) { return views[x].pred.range < views[y].pred.range; });
   std::vector<bool> keep(views.size(), true);
-  for (size_t a = 0; a < views.size(); ++a) {
+  for (size_t oi = 0; oi < order.size(); ++oi) {
+    const size_t a = order[oi];
     const TargetView& va = views[a];
     const sim::Target& ta = world.targets[va.target];
-    for (size_t b = 0; b < views.size() && keep[a]; ++b) {
-      if (a == b) continue;
-      const TargetView& vb = views[b];
-      if (std::fabs(va.pred.range - vb.pred.range) < 2.0 * va.gate.range &&
-          std::fabs(wrapPi(va.pred.azimuth - vb.pred.azimuth)) < 2.0 * va.gate.azimuth)
-        keep[a] = false;
+    const double win = 2.0 * va.gate.range + 0.5;
+    for (int dir = -1; dir <= 1 && keep[a]; dir += 2) {
+      for (long oj = static_cast<long>(oi) + dir; oj >= 0 && oj < static_cast<long>(order.size());
+           oj += dir) {
+        const TargetView& vb = views[order[oj]];
+        if (std::fabs(va.pred.range - vb.pred.range) >= win) break;
+        if (std::fabs(wrapPi(va.pred.azimuth - vb.pred.azimuth)) < 2.0 * va.gate.azimuth &&
+            world.targets[vb.target].rcs > ta.rcs - opt.dominance_db) {
+          keep[a] = false;
+          break;
+        }
+      }
     }
+    if (!keep[a]) continue;
     const sim::Pose2 s = traj.at(va.pred.stamp - base.timestamp_offset);
+    const double c = std::cos(s.yaw), sn = std::sin(s.yaw);
+    // Polar footprint of the gate, widened by the point spread (~0.5 m, ~1.5 deg).
+    const double half_r = 1.5 * va.gate.range + 0.5, half_a = 1.5 * va.gate.azimuth + 0.025;
+    const double reach = half_r + va.pred.true_range * half_a + 1.0;
+    const double bearing = va.pred.azimuth - base.azimuth_offset;
     for (const sim::Wall& w : world.walls) {
       if (!keep[a]) break;
-      if (segmentDistance(ta.x, ta.y, w) <
-          va.gate.range + va.pred.range * va.gate.azimuth * 2.0 + 0.5)
-        keep[a] = false;
-      else if (segmentsCross(s.x, s.y, ta.x, ta.y, w))
-        keep[a] = false;
+      // A wall scatterer every ~0.25 m: rcs_per_m - 6 dB, texture up to ~+20 dB.
+      const bool wall_weak = w.rcs_per_m - 6.0 + 20.0 + opt.dominance_db <= ta.rcs;
+      if (segmentsCross(s.x, s.y, ta.x, ta.y, w)) {
+        keep[a] = false;  // shadowed
+        continue;
+      }
+      if (wall_weak || segmentDistance(ta.x, ta.y, w) > reach) continue;
+      // Walk the wall in 0.2 m steps; any point inside the footprint spoils the gate.
+      const double len = std::hypot(w.x2 - w.x1, w.y2 - w.y1);
+      const int n = std::max(2, static_cast<int>(len / 0.2) + 1);
+      for (int i = 0; i <= n && keep[a]; ++i) {
+        const double u = static_cast<double>(i) / n;
+        const double dx = w.x1 + u * (w.x2 - w.x1) - s.x, dy = w.y1 + u * (w.y2 - w.y1) - s.y;
+        const double xs = c * dx + sn * dy, ys = -sn * dx + c * dy;
+        if (std::fabs(std::hypot(xs, ys) - va.pred.true_range) < half_r &&
+            std::fabs(wrapPi(std::atan2(-ys, xs) - bearing)) < half_a)
+          keep[a] = false;
+      }
     }
   }
   std::vector<TargetView> out;

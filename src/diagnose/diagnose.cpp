@@ -390,11 +390,22 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
   }
   rep.after = rep.before;
   if (opt.resimulate_after && !rep.effects.empty()) {
-    sim::PhysicsConfig ph = in.base;
+    // Ablation: each effect is kept only if switching it on in the simulator lowers the
+    // re-simulated residual; a selection the re-simulation does not confirm (a linearisation
+    // artefact of a larger effect) is reported in the notes instead.
+    sim::PhysicsConfig confirmed = in.base;
+    std::vector<double> prev_er(rep.obs.size()), prev_ea(rep.obs.size());
+    for (size_t i = 0; i < rep.obs.size(); ++i) {
+      prev_er[i] = rep.obs[i].e_r;
+      prev_ea[i] = rep.obs[i].e_az;
+    }
+    std::vector<EffectResult> kept;
     for (size_t j = 0; j < rep.effects.size(); ++j) {
       const EffectResult& r = rep.effects[j];
-      ph = r.effect == Effect::MotionDistortion ? withEffect(ph, r.effect, r.change > 0.5 ? 1 : 0)
-                                                : withEffect(ph, r.effect, r.change);
+      const sim::PhysicsConfig ph =
+          r.effect == Effect::MotionDistortion
+              ? withEffect(confirmed, r.effect, r.change > 0.5 ? 1 : 0)
+              : withEffect(confirmed, r.effect, r.change);
       sim::Simulator s(in.world, in.trajectory, in.sensor, ph, opt.seed);
       std::vector<double> er_j(rep.obs.size(), NAN), ea_j(rep.obs.size(), NAN);
       for (size_t k = 0; k < in.scans.size(); ++k) {
@@ -433,28 +444,39 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
         if (std::fabs(er_s[i]) > opt.outlier_sigma * sr_j ||
             std::fabs(ea_s[i]) > opt.outlier_sigma * sa_j)
           use_j[i] = false;
-      rep.after_step.push_back(stats(rep.obs, er_s, ea_s, use_j, sweep));
-      std::vector<double> prev_r, prev_a;
-      for (size_t i = 0; i < rep.obs.size(); ++i) {
-        prev_r.push_back(j == 0 ? rep.obs[i].e_r : rep.after_e_r[j - 1][i]);
-        prev_a.push_back(j == 0 ? rep.obs[i].e_az : rep.after_e_az[j - 1][i]);
-        if (!std::isfinite(prev_r.back())) {
-          prev_r.back() = rep.obs[i].e_r;
-          prev_a.back() = rep.obs[i].e_az;
-        }
-      }
-      const ResidualStats before = stats(rep.obs, prev_r, prev_a, use_j, sweep);
-      EffectResult& rj = rep.effects[j];
+      const ResidualStats after = stats(rep.obs, er_s, ea_s, use_j, sweep);
+      const ResidualStats before = stats(rep.obs, prev_er, prev_ea, use_j, sweep);
+      EffectResult rj = rep.effects[j];
       rj.residual_rms_before = before.position_rms;
-      rj.residual_rms_after = rep.after_step.back().position_rms;
+      rj.residual_rms_after = after.position_rms;
       rj.range_rms_before = before.range_rms;
-      rj.range_rms_after = rep.after_step.back().range_rms;
+      rj.range_rms_after = after.range_rms;
       rj.azimuth_rms_before = before.azimuth_rms;
-      rj.azimuth_rms_after = rep.after_step.back().azimuth_rms;
+      rj.azimuth_rms_after = after.azimuth_rms;
+      if (!(after.position_rms < before.position_rms)) {
+        std::ostringstream n;
+        n << rj.name << " (" << rj.value << " +- " << rj.stddev << " " << rj.unit << ", z "
+          << rj.significance << ") passed the regression test but switching it on in the "
+          << "simulator did not lower the residual (" << before.position_rms << " -> "
+          << after.position_rms << " m); not reported as an effect.";
+        rep.notes.push_back(n.str());
+        continue;
+      }
+      confirmed = ph;
+      prev_er = er_s;
+      prev_ea = ea_s;
+      rep.after_step.push_back(after);
       rep.after_e_r.push_back(er_j);
       rep.after_e_az.push_back(ea_j);
+      kept.push_back(rj);
     }
-    rep.after = rep.after_step.back();
+    rep.effects = kept;
+    rep.fitted = confirmed;
+    rep.mismatch_found = !rep.effects.empty();
+    if (!rep.after_step.empty()) {
+      std::vector<bool> all = use;
+      rep.after = stats(rep.obs, prev_er, prev_ea, all, sweep);
+    }
   } else {
     // No re-simulation: the linear model's residuals stand in for the "after" figures.
     std::vector<double> fr, fa;

@@ -73,6 +73,7 @@ TEST_P(Concealed, NamesAndFitsTheHiddenEffect) {
   }
   ASSERT_TRUE(rep.mismatch_found);
   ASSERT_FALSE(rep.effects.empty());
+  EXPECT_EQ(rep.effects.size(), 1u);
   EXPECT_EQ(rep.effects.front().name, c.expect);
   EXPECT_NEAR(rep.effects.front().value, c.value, 0.1 * std::fabs(c.value));
   EXPECT_LT(rep.after.position_rms, rep.before.position_rms);

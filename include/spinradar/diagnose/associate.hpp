@@ -46,6 +46,7 @@ struct ViewOptions {
   double max_range_margin = 2;  ///< m below the last bin
   double gate_range_min = 0.8;  ///< m
   double gate_azimuth_min = 0.045;  ///< rad (~2.6 deg)
+  double dominance_db = 8.0;    ///< other returns in the gate must be this much weaker (RCS)
 };
 
 /// Views of all usable targets in one scan; gates widen with speed and yaw rate so that the
