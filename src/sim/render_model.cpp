@@ -30,16 +30,20 @@ double hannResponse(double x) {
 }  // namespace
 
 RenderModel::RenderModel(const SensorConfig& s) : s_(s) {
-  // Range point spread: power = |W|^2 of the Hann window response, sampled per sub-bin phase.
+  // Range point spread: Gaussian-like mainlobe in power (fits real Navtech peaks: -29 dB at
+  // +-10 bins for sigma 2.7) plus window sidelobes decaying as offset^-3.
   psf_half_ = s.range_psf_half_width;
-  psf_main_half_ = std::min(psf_half_, int(std::ceil(2.0 * s.range_cell_bins)));
+  psf_sigma_ = float(s.range_psf_sigma_bins);
+  double sl = std::pow(10.0, s.range_sidelobe_db / 10.0);
+  sidelobe_ratio_ = float(1.0 / sl);
   int taps = 2 * psf_half_ + 1;
   psf_.resize(size_t(kPhases) * taps);
   for (int p = 0; p < kPhases; ++p) {
     double frac = double(p) / kPhases;
     for (int k = -psf_half_; k <= psf_half_; ++k) {
-      double w = hannResponse((k - frac) / s.range_cell_bins);
-      psf_[size_t(p) * taps + (k + psf_half_)] = float(w * w);
+      double x = (k - frac) / s.range_psf_sigma_bins;
+      double side = std::abs(x) > 2.0 ? sl * std::pow(2.0 / std::abs(x), 3.0) : sl;
+      psf_[size_t(p) * taps + (k + psf_half_)] = float(std::exp(-0.5 * x * x) + side);
     }
   }
 
@@ -78,6 +82,11 @@ RenderModel::RenderModel(const SensorConfig& s) : s_(s) {
   float m = 0;
   for (int i = nb - 1; i >= 0; --i) beam_tail_[i] = m = std::max(m, beam_[i]);
 
+  beam_hw_.resize(4 * 64 + 2);
+  for (size_t i = 0; i < beam_hw_.size(); ++i)
+    beam_hw_[i] = beamHalfWidthFor(std::pow(2.0, -double(i) / 4.0));
+  for (int m = 0; m < 1024; ++m) log2_mant_[m] = float(std::log2(1.0 + (m + 0.5) / 1024.0));
+
   // Noise floor + diffuse clutter per bin (clutter is range dependent, referenced to 10 m).
   noise_lin_.resize(s.bins);
   thr_lin_.resize(s.bins);
@@ -89,7 +98,7 @@ RenderModel::RenderModel(const SensorConfig& s) : s_(s) {
     double c = std::pow(10.0, (s.noise_floor_db + s.clutter_db + s.clutter_db_per_decade * lr) / 10.0);
     double tot = n + (s.clutter_db > 0 ? c : 0.0);
     noise_lin_[b] = float(tot);
-    noise_q_[b] = int(std::lround(80.0 * std::log10(tot)));
+    noise_q_[b] = int16_t(std::clamp(std::lround(80.0 * std::log10(tot)), -600l, 1600l));
     thr_lin_[b] = float(tot * std::pow(10.0, s.render_threshold_db / 10.0));
   }
 
@@ -99,22 +108,49 @@ RenderModel::RenderModel(const SensorConfig& s) : s_(s) {
   for (size_t i = 0; i < range_factor_.size(); ++i)
     range_factor_[i] = float(pointPower(0.0, std::max((i + 0.5) * rf_step, 0.1)));
 
-  // Speckle: exponential power samples (stratified; indexed at random when rendering).
-  int ns = 1 << kSpeckleBits;
-  speckle_lin_.resize(ns);
-  speckle_q_.resize(ns);
-  for (int i = 0; i < ns; ++i) {
-    double u = (i + 0.5) / ns;
-    double e = -std::log(u);
-    speckle_lin_[i] = float(e);
-    speckle_q_[i] = int16_t(std::lround(80.0 * std::log10(e)));
+  // Speckle: complex white noise through the amplitude response of the range window (the
+  // square root of the Gaussian power PSF), |z|^2 normalised to mean 1: exponential marginal,
+  // range-correlated like real receiver noise.
+  {
+    const int ns = 1 << kSpeckleBits;
+    Rng rng(0x5EC3C1Eull);
+    std::vector<double> re(ns), im(ns);
+    for (int i = 0; i < ns; ++i) {
+      re[i] = rng.normal();
+      im[i] = rng.normal();
+    }
+    double sig_a = std::sqrt(2.0) * s.range_psf_sigma_bins;  // amplitude response std
+    int hw = int(std::ceil(3 * sig_a));
+    std::vector<double> h(size_t(2 * hw + 1));
+    for (int k = -hw; k <= hw; ++k) h[k + hw] = std::exp(-0.5 * k * k / (sig_a * sig_a));
+    std::vector<double> pw(ns);
+    double mean = 0;
+    for (int i = 0; i < ns; ++i) {
+      double zr = 0, zi = 0;
+      for (int k = -hw; k <= hw; ++k) {
+        int j = (i + k) & (ns - 1);
+        zr += h[k + hw] * re[j];
+        zi += h[k + hw] * im[j];
+      }
+      pw[i] = zr * zr + zi * zi;
+      mean += pw[i];
+    }
+    mean /= ns;
+    speckle_lin_.resize(ns);
+    speckle_q_.resize(ns);
+    for (int i = 0; i < ns; ++i) {
+      double e = std::max(pw[i] / mean, 1e-5);
+      speckle_lin_[i] = float(e);
+      speckle_q_[i] = int16_t(std::lround(80.0 * std::log10(e)));
+    }
   }
 
   // Quantiser: power (1/8 dB) -> amplitude A -> integer magnitude n = floor(A) ->
   // round(power_scale * 20 log10 n). This reproduces the native Navtech code set
   // (0, 6, 9, 12, 14, 15, 17, ...) and its many zeros.
-  q_min_ = -8 * 40;
-  int q_max = 8 * 320;
+  // Range: noise level [-600, 1600] + speckle [-400, 100] + row offset +-160, and signals.
+  q_min_ = -1200;
+  int q_max = 8 * 330;
   lut_.resize(size_t(q_max - q_min_ + 1));
   for (int q = q_min_; q <= q_max; ++q) {
     double a = std::pow(10.0, q / 8.0 / 20.0);
@@ -137,9 +173,5 @@ double RenderModel::pointPower(double rcs_db, double r) const {
   return std::pow(10.0, db / 10.0);
 }
 
-uint8_t RenderModel::countOfLin(float p) const {
-  if (!(p > 0)) return 0;
-  return countOfQ(int(std::lround(80.0f * std::log10(p))));
-}
 
 }  // namespace spinradar::sim::detail

@@ -190,15 +190,17 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
   const double tol = sensor.occlusion_tolerance;
   w.pairs.clear();
   const double noise_mid = model.thresholdLin(std::min(M - 1, M / 2));
+  const double r_cull = r_max + travel;
   auto bucket = [&](const Scatterer& sc, uint32_t id, double x, double y) {
     double dx = x - mx, dy = y - my;
-    double r = std::hypot(dx, dy);
-    if (r > r_max + travel || r < 0.05) return;
+    double r2 = dx * dx + dy * dy;
+    if (r2 > r_cull * r_cull || r2 < 0.0025) return;
+    double r = std::sqrt(r2);
     int b = std::clamp(int(r / res), 0, M - 1);
     double p = double(sc.rcs_lin) * model.rangeFactor(std::max(r - travel, 0.3));
     double thr = std::min<double>(model.thresholdLin(b), noise_mid);
     if (p <= thr) return;
-    double half = model.beamHalfWidthFor(thr / p);
+    double half = model.beamHalfWidthForRatio(p / thr);
     // Crossing azimuth: fixed point of "beam angle at azimuth a = bearing from pose a".
     int a = azOf(bearingCw(x, y, mx, my, w.cyaw[a_mid], w.syaw[a_mid]));
     for (int it = 0; it < 2; ++it)
@@ -232,11 +234,12 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
     int cy0 = std::max(0, int((my - rad - gy0) / cell)), cy1 = std::min(gny - 1, int((my + rad - gy0) / cell));
     for (int cy = cy0; cy <= cy1; ++cy)
       for (int cx = cx0; cx <= cx1; ++cx) {
+        // Skip cells entirely outside the visible disc.
+        double ex = std::max({gx0 + cx * cell - mx, mx - (gx0 + (cx + 1) * cell), 0.0});
+        double ey = std::max({gy0 + cy * cell - my, my - (gy0 + (cy + 1) * cell), 0.0});
+        if (ex * ex + ey * ey > r_cull * r_cull) continue;
         size_t c = size_t(cy) * gnx + cx;
-        for (uint32_t k = cell_start[c]; k < cell_start[c + 1]; ++k) {
-          const Scatterer& sc = statics[cell_items[k]];
-          bucket(sc, cell_items[k], sc.x, sc.y);
-        }
+        for (uint32_t k = cell_start[c]; k < cell_start[c + 1]; ++k) bucket(statics[k], k, statics[k].x, statics[k].y);
       }
   }
   // Wall scatterers: only walls that are the first hit somewhere (others are hidden).
@@ -261,15 +264,23 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
   }
 
   // ---- rows
-  const int H = model.psfHalf(), Hm = model.psfMainHalf();
+  const int H = model.psfHalf();
   const double beta = physics.doppler;
   const double atten = fx.attenuation_db_per_km;
   const double inc_n = sensor.incidence_exponent;
-  const float strong = float(std::pow(10.0, 3.3));  // sidelobes (-31.5 dB) matter above this
   w.row.resize(M);
+  w.level.resize(M);
+  // Per-azimuth noise level: AR(1) across azimuths with the configured stationary std.
+  const double row_rho = 0.6;
+  const double row_innov = sensor.noise_row_jitter_db * std::sqrt(1 - row_rho * row_rho);
+  double row_level = sensor.noise_row_jitter_db * scan_rng.normal();
+  std::fill(w.row.begin(), w.row.end(), 0.f);
+  const uint8_t* count_table = model.countTable();
+  const int16_t* noise_q = model.noiseQData();
+  const int16_t* speckle_q = model.speckleQData();
   for (int a = 0; a < N; ++a) {
     float* row = w.row.data();
-    std::fill(row, row + M, 0.f);
+    int lo = M, hi = -1;  // touched bins
     const double px = w.px[a], py = w.py[a], c = w.cyaw[a], s = w.syaw[a];
     const double psi_a = w.psi[a];
     const double t_a = w.t_render[a];
@@ -328,26 +339,38 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
       }
       int bc = std::clamp(b0, 0, M - 1);
       float pf = float(p);
-      if (pf < model.thresholdLin(bc)) continue;
-      int h = pf > model.noiseLin(bc) * strong ? H : Hm;
+      float thr = model.thresholdLin(bc);
+      if (pf < thr) continue;
+      int h = model.psfHalfFor(pf / thr);
       const float* taps = model.psf(phase) + H;
       int k0 = std::max(-h, -b0), k1 = std::min(h, M - 1 - b0);
+      if (k0 > k1) continue;
       for (int kk = k0; kk <= k1; ++kk) row[b0 + kk] += pf * taps[kk];
+      lo = std::min(lo, b0 + k0);
+      hi = std::max(hi, b0 + k1);
     }
-    // Noise floor (speckle) everywhere; signal cells add their power before the quantiser.
+    // Noise floor (range-correlated speckle, per-azimuth level jitter) everywhere; signal
+    // cells add their power before the quantiser.
     detail::Rng rng(seed ^ detail::Rng::splitmix(scan_key * 1315423911ull + uint64_t(a)));
+    // Start inside the table so that the row needs no wrap-around.
+    const uint32_t start = uint32_t(rng.next() % uint64_t(detail::RenderModel::kSpeckleMask + 1 - M));
+    row_level = row_rho * row_level + row_innov * rng.normal();
+    const int dq = std::clamp(int(std::lround(row_level * 8.0)),
+                              -detail::RenderModel::kMaxRowOffsetQ,
+                              detail::RenderModel::kMaxRowOffsetQ);
+    const float gain = float(std::pow(10.0, dq / 80.0));
     uint8_t* o = out.row(a);
-    int b = 0;
-    for (; b < M; b += 4) {
-      uint64_t rv = rng.next();
-      int kmax = std::min(4, M - b);
-      for (int q = 0; q < kmax; ++q) {
-        uint32_t idx = uint32_t(rv >> (16 * q));
-        float sig = row[b + q];
-        o[b + q] = sig == 0.f
-                       ? model.countOfQ(model.noiseQ(b + q) + model.speckleQ(idx))
-                       : model.countOfLin(model.noiseLin(b + q) * model.speckleLin(idx) + sig);
-      }
+    const uint8_t* table = count_table + dq;
+    const int16_t* sq = speckle_q + start;
+    int16_t* lvl = w.level.data();
+    for (int b = 0; b < M; ++b) lvl[b] = int16_t(noise_q[b] + sq[b]);  // vectorises
+    for (int b = 0; b < M; ++b) o[b] = table[lvl[b]];
+    for (int b = std::max(lo, 0); b <= hi; ++b) {
+      float sig = row[b];
+      if (sig == 0.f) continue;
+      uint32_t idx = start + uint32_t(b);
+      o[b] = model.countOfLin(gain * model.noiseLin(b) * model.speckleLin(idx) + sig);
+      row[b] = 0.f;  // leave the row clean for the next azimuth
     }
   }
 }

@@ -26,6 +26,28 @@ void addBox(World& w, double cx, double cy, double len, double wid, double yaw, 
   }
 }
 
+/// Diffuse ground clutter (kerbs, grass, road surface, debris) as weak scatterers at `density`
+/// per m^2 where `keep(x, y)` holds, and trees/bushes as clumps of scatterers.
+template <class Keep>
+void addClutter(World& w, Rng& rng, double x0, double y0, double x1, double y1, double density,
+                Keep keep) {
+  int n = int((x1 - x0) * (y1 - y0) * density);
+  for (int i = 0; i < n; ++i) {
+    double x = uni(rng, x0, x1), y = uni(rng, y0, y1);
+    if (!keep(x, y)) continue;
+    w.targets.push_back({x, y, -42.0 + 7.0 * rng.normal(), 0, 0});
+  }
+}
+
+void addTree(World& w, Rng& rng, double cx, double cy, double radius) {
+  int n = 8 + int(rng.uniform() * 12);
+  double base = uni(rng, -30, -18);
+  for (int i = 0; i < n; ++i) {
+    double r = radius * std::sqrt(rng.uniform()), a = uni(rng, 0, 2 * M_PI);
+    w.targets.push_back({cx + r * std::cos(a), cy + r * std::sin(a), base + 5 * rng.normal(), 0, 0});
+  }
+}
+
 /// Builds a motion profile: speed ramps, straights and constant-radius turns.
 class Route {
  public:
@@ -107,7 +129,7 @@ Scene city(uint64_t variant, double t0) {
         double sb[4] = {uni(rng, 0, 2.5), uni(rng, 0, 2.5), uni(rng, 0, 2.5), uni(rng, 0, 2.5)};
         double bx0 = along_x ? pos : x0 + sb[0], bx1 = along_x ? end - gap : x1 - sb[1];
         double by0 = along_x ? y0 + sb[2] : pos, by1 = along_x ? y1 - sb[3] : end - gap;
-        double rpm = uni(rng, -4.0, 4.0);
+        double rpm = uni(rng, 0.0, 8.0);
         double cx = (bx0 + bx1) / 2, cy = (by0 + by1) / 2;
         addBox(w, cx, cy, bx1 - bx0, by1 - by0, 0.0, rpm);
         pos = end;
@@ -119,7 +141,7 @@ Scene city(uint64_t variant, double t0) {
       for (double u = uni(rng, 0, 10); u < G * P; u += uni(rng, 15, 35)) {
         if (std::fmod(u, P) < 9 || std::fmod(u, P) > P - 9) continue;  // keep junctions clear
         double off = side * uni(rng, 6.0, 6.8);
-        double rcs = uni(rng, 2, 14);
+        double rcs = uni(rng, 5, 18);
         w.targets.push_back({u, k * P + off, rcs, 0, 0});   // along x-streets
         w.targets.push_back({k * P + off, u, rcs, 0, 0});   // along y-streets
       }
@@ -130,7 +152,7 @@ Scene city(uint64_t variant, double t0) {
         double m = std::fmod(u, P);
         if (m < 10 || m > P - 12 || rng.uniform() > 0.35) continue;
         double off = side * 4.8;
-        double rpm = uni(rng, 2, 8);
+        double rpm = uni(rng, 6, 12);
         addBox(w, u + 2.2, k * P + off, 4.4, 1.8, 0.0, rpm);
         addBox(w, k * P + off, u + 2.2, 4.4, 1.8, M_PI / 2, rpm);
       }
@@ -143,7 +165,7 @@ Scene city(uint64_t variant, double t0) {
         for (double u = -3000 + uni(rng, 0, 200); u < G * P + 3000; u += uni(rng, 180, 320)) {
           for (int p = -1; p <= 1; ++p) {
             double along = u + p * 1.8;
-            double rcs = p == 0 ? 8.0 : 12.0;
+            double rcs = p == 0 ? 14.0 : 18.0;
             if (axis == 0)
               w.targets.push_back({along, k * P + lane, rcs, v, 0});
             else
@@ -151,6 +173,30 @@ Scene city(uint64_t variant, double t0) {
           }
         }
       }
+
+  // Ground clutter in the streets and front yards, trees along the kerbs.
+  auto in_street = [&](double x, double y) {
+    double mx = std::fmod(x + P, P), my = std::fmod(y + P, P);
+    return mx < half_street + 2.5 || mx > P - half_street - 2.5 || my < half_street + 2.5 ||
+           my > P - half_street - 2.5;
+  };
+  addClutter(w, rng, -40, -40, G * P + 40, G * P + 40, 0.25, in_street);
+  for (int k = 0; k <= G; ++k)
+    for (int side = -1; side <= 1; side += 2)
+      for (double u = uni(rng, 0, 20); u < G * P; u += uni(rng, 15, 45)) {
+        double m = std::fmod(u, P);
+        if (m < 10 || m > P - 10) continue;
+        double off = side * uni(rng, 7.5, 9.0);
+        if (rng.uniform() < 0.5)
+          addTree(w, rng, u, k * P + off, uni(rng, 1.0, 2.5));
+        else
+          addTree(w, rng, k * P + off, u, uni(rng, 1.0, 2.5));
+      }
+  // Outside the grid: open land with scattered trees.
+  for (int i = 0; i < 150; ++i) {
+    double a = uni(rng, 0, 2 * M_PI), r = uni(rng, 0.75, 1.2) * G * P;
+    addTree(w, rng, G * P / 2 + r * std::cos(a), G * P / 2 + r * std::sin(a), uni(rng, 1.5, 4));
+  }
 
   // Route over the street grid (node polyline, successive legs perpendicular).
   const int nodes[][2] = {{0, 0}, {4, 0}, {4, 3}, {2, 3}, {2, 5}, {6, 5}, {6, 1},
@@ -191,16 +237,19 @@ Scene outAndBack(uint64_t variant, double t0) {
   const double L = 1000;
   for (int side = -1; side <= 1; side += 2) {
     for (double x = uni(rng, -20, 0); x < L + 40; x += uni(rng, 18, 32))
-      w.targets.push_back({x, side * uni(rng, 6.5, 8.0), uni(rng, 4, 14), 0, 0});
+      w.targets.push_back({x, side * uni(rng, 6.5, 8.0), uni(rng, 5, 18), 0, 0});
     for (double x = uni(rng, -40, 0); x < L + 60;) {
       double len = uni(rng, 15, 60), depth = uni(rng, 10, 20);
       double y0 = side * uni(rng, 12, 20);
-      addBox(w, x + len / 2, y0 + side * depth / 2, len, depth, 0.0, uni(rng, -4, 4));
+      addBox(w, x + len / 2, y0 + side * depth / 2, len, depth, 0.0, uni(rng, 0, 8));
       x += len + uni(rng, 5, 35);
     }
     for (double x = 0; x < L; x += 7)
-      if (rng.uniform() < 0.2) addBox(w, x, side * 4.8, 4.4, 1.8, 0.0, uni(rng, 2, 8));
+      if (rng.uniform() < 0.2) addBox(w, x, side * 4.8, 4.4, 1.8, 0.0, uni(rng, 6, 12));
+    for (double x = uni(rng, -30, 0); x < L + 40; x += uni(rng, 10, 40))
+      addTree(w, rng, x, side * uni(rng, 9, 40), uni(rng, 1.0, 3.0));
   }
+  addClutter(w, rng, -60, -60, L + 60, 60, 0.08, [](double, double y) { return std::abs(y) > 3.5; });
   Route route;
   route.leg(300, 15.0, 15.0, 2.0, 2.0);
   route.leg(300, 20.0, 20.0, 1.5, 2.0);
@@ -226,12 +275,17 @@ Scene tightTurns(uint64_t variant, double t0) {
   World& w = sc.world;
   for (int i = 0; i < 70; ++i) {
     double r = uni(rng, 25, 110), a = uni(rng, 0, 2 * M_PI);
-    w.targets.push_back({60 + r * std::cos(a), r * std::sin(a), uni(rng, 0, 15), 0, 0});
+    w.targets.push_back({60 + r * std::cos(a), r * std::sin(a), uni(rng, 5, 18), 0, 0});
   }
   for (int i = 0; i < 24; ++i) {
     double r = uni(rng, 45, 100), a = uni(rng, 0, 2 * M_PI);
-    addBox(w, 60 + r * std::cos(a), r * std::sin(a), 12.2, 2.5, uni(rng, 0, M_PI), uni(rng, 2, 8));
+    addBox(w, 60 + r * std::cos(a), r * std::sin(a), 12.2, 2.5, uni(rng, 0, M_PI), uni(rng, 4, 10));
   }
+  for (int i = 0; i < 40; ++i) {
+    double r = uni(rng, 30, 120), a = uni(rng, 0, 2 * M_PI);
+    addTree(w, rng, 60 + r * std::cos(a), r * std::sin(a), uni(rng, 1.0, 3.0));
+  }
+  addClutter(w, rng, -70, -130, 190, 130, 0.06, [](double, double) { return true; });
   // Perimeter fence with gaps.
   const double X0 = -70, X1 = 190, Y0 = -130, Y1 = 130;
   auto fence = [&](double x1, double y1, double x2, double y2) {
@@ -240,7 +294,7 @@ Scene tightTurns(uint64_t variant, double t0) {
       if (rng.uniform() < 0.2) continue;
       double a = double(k) / n, b = (k + 0.9) / n;
       w.walls.push_back({x1 + a * (x2 - x1), y1 + a * (y2 - y1), x1 + b * (x2 - x1),
-                         y1 + b * (y2 - y1), uni(rng, -2, 4)});
+                         y1 + b * (y2 - y1), uni(rng, 0, 6)});
     }
   };
   fence(X0, Y0, X1, Y0);

@@ -13,6 +13,8 @@ namespace spinradar::sim {
 
 void SensorConfig::validate() const {
   checkParamRanges(*this, "sensor");
+  if (bins > (1 << 18) - 1024)
+    throw std::invalid_argument("sensor parameter 'bins' is too large for the speckle table");
   if (encoder_size < azimuths)
     throw std::invalid_argument("sensor parameter 'encoder_size' must be at least 'azimuths'");
 }

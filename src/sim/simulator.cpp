@@ -116,8 +116,6 @@ void Simulator::Impl::buildScatterers() {
                                                             detail::Rng::splitmix(bitsOf(w.y2)))));
     detail::Rng rng(key);
     double base = w.rcs_per_m + 10.0 * std::log10(sp);
-    wall_first.push_back(uint32_t(statics.size()));
-    wall_count.push_back(uint32_t(n));
     for (int i = 0; i < n; ++i) {
       double u = (i + 0.5 + 0.6 * (rng.uniform() - 0.5)) / n;
       Scatterer s;
@@ -158,6 +156,8 @@ void Simulator::Impl::buildScatterers() {
 }
 
 void Simulator::Impl::buildGrid() {
+  // Point scatterers (not walls) are reordered by grid cell so that a cell is a contiguous
+  // index range (cache-friendly culling); wall scatterers follow, wall by wall.
   double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
   for (const auto& s : statics) {
     if (s.wall >= 0) continue;
@@ -166,26 +166,36 @@ void Simulator::Impl::buildGrid() {
     x1 = std::max(x1, s.x);
     y1 = std::max(y1, s.y);
   }
-  if (x0 > x1) return;  // no point scatterers
-  // Keep the grid small for huge sparse worlds.
-  cell = std::max(16.0, std::max(x1 - x0, y1 - y0) / 2048.0);
-  gx0 = x0;
-  gy0 = y0;
-  gnx = int((x1 - x0) / cell) + 1;
-  gny = int((y1 - y0) / cell) + 1;
-  cell_start.assign(size_t(gnx) * gny + 1, 0);
-  auto cellOf = [&](const Scatterer& s) {
-    int cx = std::min(gnx - 1, int((s.x - gx0) / cell));
-    int cy = std::min(gny - 1, int((s.y - gy0) / cell));
-    return size_t(cy) * gnx + cx;
-  };
-  for (const auto& s : statics)
-    if (s.wall < 0) ++cell_start[cellOf(s) + 1];
-  for (size_t i = 1; i < cell_start.size(); ++i) cell_start[i] += cell_start[i - 1];
-  cell_items.resize(cell_start.back());
-  std::vector<uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
-  for (size_t i = 0; i < statics.size(); ++i)
-    if (statics[i].wall < 0) cell_items[fill[cellOf(statics[i])]++] = uint32_t(i);
+  std::vector<Scatterer> points, walls_pts;
+  for (const auto& s : statics) (s.wall >= 0 ? walls_pts : points).push_back(s);
+  gnx = gny = 0;
+  cell_start.clear();
+  if (!points.empty()) {
+    // Keep the grid small for huge sparse worlds.
+    cell = std::max(16.0, std::max(x1 - x0, y1 - y0) / 2048.0);
+    gx0 = x0;
+    gy0 = y0;
+    gnx = int((x1 - x0) / cell) + 1;
+    gny = int((y1 - y0) / cell) + 1;
+    auto cellOf = [&](const Scatterer& s) {
+      int cx = std::min(gnx - 1, int((s.x - gx0) / cell));
+      int cy = std::min(gny - 1, int((s.y - gy0) / cell));
+      return size_t(cy) * gnx + cx;
+    };
+    std::stable_sort(points.begin(), points.end(), [&](const Scatterer& a, const Scatterer& b) {
+      return cellOf(a) < cellOf(b);
+    });
+    cell_start.assign(size_t(gnx) * gny + 1, 0);
+    for (const auto& s : points) ++cell_start[cellOf(s) + 1];
+    for (size_t i = 1; i < cell_start.size(); ++i) cell_start[i] += cell_start[i - 1];
+  }
+  statics = std::move(points);
+  wall_first.assign(world.walls.size(), 0);
+  wall_count.assign(world.walls.size(), 0);
+  for (const auto& s : walls_pts) {
+    if (wall_count[s.wall]++ == 0) wall_first[s.wall] = uint32_t(statics.size());
+    statics.push_back(s);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -48,6 +48,7 @@ struct ScanWork {
   std::vector<uint64_t> pairs;  // (azimuth << 32) | scatterer index (movers: | 1 << 31)
   std::vector<uint32_t> bucket_start, bucket_items;
   std::vector<float> row;
+  std::vector<int16_t> level;
   std::vector<uint32_t> candidates;
 };
 
@@ -72,7 +73,7 @@ struct Simulator::Impl {
   // Uniform grid over the statics that are not wall scatterers (CSR).
   double gx0 = 0, gy0 = 0, cell = 16.0;
   int gnx = 0, gny = 0;
-  std::vector<uint32_t> cell_start, cell_items;
+  std::vector<uint32_t> cell_start;  ///< cell c holds statics[cell_start[c] .. cell_start[c+1])
   std::vector<double> depth_cos, depth_sin;  ///< per occlusion angle bin
 
   Impl(World w, Trajectory t, SensorConfig s, PhysicsConfig p, uint64_t sd);

@@ -19,14 +19,16 @@
   X(double, power_scale, 1.0, 0.1, 10.0, "count/dB", "Output counts per dB (Navtech: about 1)") \
   X(double, saturation, 255.0, 1.0, 255.0, "count", "Largest output value") \
   X(double, min_range, 0.5, 0.0, 50.0, "m", "Returns closer than this are not rendered") \
-  X(double, radar_constant_db, 80.0, 0.0, 300.0, "dB", "Received power of a 0 dBsm point at 1 m before range gain") \
+  X(double, radar_constant_db, 95.0, 0.0, 300.0, "dB", "Received power of a 0 dBsm point at 1 m before range gain") \
   X(double, noise_range_slope_db_per_decade, 0.0, -40.0, 40.0, "dB/dec", "Noise floor change per decade of range (from 10 m)") \
-  X(double, clutter_db, 14.0, 0.0, 80.0, "dB", "Diffuse ground clutter power at 10 m, above the noise floor") \
+  X(double, clutter_db, 4.0, 0.0, 80.0, "dB", "Diffuse ground clutter power at 10 m, above the noise floor") \
   X(double, clutter_db_per_decade, -14.0, -60.0, 0.0, "dB/dec", "Ground clutter change per decade of range") \
-  X(double, range_cell_bins, 1.6, 0.5, 10.0, "bins", "Range resolution cell of the FFT (Hann mainlobe null at 2 cells)") \
-  X(int, range_psf_half_width, 24, 2, 64, "bins", "Half width of the rendered range point spread (sidelobes)") \
-  X(double, azimuth_sidelobe_db, -28.0, -80.0, -10.0, "dB", "Two-way azimuth sidelobe plateau relative to the peak") \
-  X(double, azimuth_extent_deg, 6.0, 1.0, 30.0, "deg", "Half width of the rendered azimuth pattern") \
+  X(double, range_psf_sigma_bins, 2.7, 0.3, 20.0, "bins", "Std of the Gaussian-like range mainlobe in power (real CTS350-X/CIR204: ~2.7)") \
+  X(double, range_sidelobe_db, -60.0, -120.0, -10.0, "dB", "FFT-window range sidelobe level (decaying as offset^-3)") \
+  X(int, range_psf_half_width, 24, 2, 64, "bins", "Half width of the rendered range point spread") \
+  X(double, azimuth_sidelobe_db, -50.0, -80.0, -10.0, "dB", "Two-way azimuth sidelobe plateau relative to the peak") \
+  X(double, azimuth_extent_deg, 4.0, 1.0, 30.0, "deg", "Half width of the rendered azimuth pattern") \
+  X(double, noise_row_jitter_db, 2.0, 0.0, 20.0, "dB", "Std of the per-azimuth noise floor level (AR(1) across azimuths)") \
   X(double, incidence_exponent, 2.0, 0.0, 10.0, "", "Wall back-scatter falls as cos(incidence)^n") \
   X(double, wall_spacing, 0.25, 0.02, 5.0, "m", "Spacing of the scatterers a wall is rendered with") \
   X(double, wall_texture_db, 5.0, 0.0, 20.0, "dB", "Std of the per-scatterer facade texture") \

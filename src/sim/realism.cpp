@@ -1,0 +1,196 @@
+// Realism figures of polar scans (see realism.hpp).
+#include "spinradar/sim/realism.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <sstream>
+
+#include "spinradar/core/detector.hpp"
+#include "spinradar/core/scan_io.hpp"
+
+namespace spinradar::sim {
+
+namespace {
+
+// Pearson correlation accumulator.
+struct Corr {
+  double n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+  void add(double x, double y) {
+    n += 1, sx += x, sy += y, sxx += x * x, syy += y * y, sxy += x * y;
+  }
+  double value() const {
+    double vx = sxx - sx * sx / n, vy = syy - sy * sy / n;
+    return vx > 0 && vy > 0 ? (sxy - sx * sy / n) / std::sqrt(vx * vy) : 0.0;
+  }
+};
+
+}  // namespace
+
+RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::string& name,
+                            const RealismOptions& o) {
+  RealismStats st;
+  st.name = name;
+  st.scans = int(scans.size());
+  std::vector<double> hist(256, 0.0);
+  double band_sum[4] = {0, 0, 0, 0}, band_n[4] = {0, 0, 0, 0};
+  const double band_edge[5] = {2.5, 10, 25, 50, 100};
+  Corr az, rs, rl;
+  double det_cen = 0, det_cfar = 0;
+  std::vector<Keypoint> kps;
+  for (const PolarScan& s : scans) {
+    int b0 = std::max(0, int(std::ceil(s.binOfRange(o.min_range))));
+    int b1 = std::min(s.bins - 1, int(std::floor(s.binOfRange(o.max_range))));
+    int lag_s = std::max(1, int(std::lround(0.25 / s.range_resolution)));
+    int lag_l = std::max(1, int(std::lround(1.0 / s.range_resolution)));
+    for (int a = 0; a < s.azimuths; ++a) {
+      if (!s.valid.empty() && !s.valid[a]) continue;
+      const uint8_t* row = s.row(a);
+      const uint8_t* next = s.row((a + 1) % s.azimuths);
+      for (int b = b0; b <= b1; ++b) {
+        hist[row[b]] += 1;
+        double r = s.rangeOfBin(b);
+        for (int k = 0; k < 4; ++k)
+          if (r >= band_edge[k] && r < band_edge[k + 1]) band_sum[k] += row[b], band_n[k] += 1;
+        // Subsample the texture statistics (every 3rd cell) to keep this fast.
+        if (b % 3 == 0) {
+          az.add(row[b], next[b]);
+          if (b + lag_s <= b1) rs.add(row[b], row[b + lag_s]);
+          if (b + lag_l <= b1) rl.add(row[b], row[b + lag_l]);
+        }
+      }
+    }
+    if (o.detect) {
+      DetectorConfig dc = o.detector;
+      dc.min_range = o.min_range;
+      dc.max_range = o.max_range;
+      dc.detector = "cen2018";
+      Detector d(dc);
+      d.detect(s, kps);
+      det_cen += kps.size();
+      dc.detector = "cfar";
+      d.setConfig(dc);
+      d.detect(s, kps);
+      det_cfar += kps.size();
+    }
+  }
+  double total = 0, sum = 0;
+  for (int v = 0; v < 256; ++v) total += hist[v], sum += v * hist[v];
+  if (total == 0) return st;
+  st.zero_fraction = hist[0] / total;
+  st.mean = sum / total;
+  auto quantile = [&](double q) {
+    double c = 0;
+    for (int v = 0; v < 256; ++v) {
+      c += hist[v];
+      if (c >= q * total) return double(v);
+    }
+    return 255.0;
+  };
+  st.q50 = quantile(0.5);
+  st.q90 = quantile(0.9);
+  st.q99 = quantile(0.99);
+  st.q999 = quantile(0.999);
+  for (int v = 255; v >= 0; --v)
+    if (hist[v] > 0) {
+      st.max = v;
+      break;
+    }
+  double bright = 0;
+  for (int v = 40; v < 256; ++v) bright += hist[v];
+  st.bright_fraction = bright / total;
+  for (int k = 0; k < 4; ++k) st.band_mean[k] = band_n[k] > 0 ? band_sum[k] / band_n[k] : 0;
+  st.azimuth_corr = az.value();
+  st.range_corr_short = rs.value();
+  st.range_corr_long = rl.value();
+  if (o.detect && !scans.empty()) {
+    st.detections_cen = det_cen / scans.size();
+    st.detections_cfar = det_cfar / scans.size();
+  }
+  return st;
+}
+
+std::vector<std::pair<std::string, std::vector<PolarScan>>> loadRealSamples(
+    const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::vector<std::pair<std::string, std::vector<PolarScan>>> out;
+  auto sorted = [](const fs::path& p, const std::string& ext) {
+    std::vector<std::string> files;
+    if (fs::is_directory(p))
+      for (const auto& e : fs::directory_iterator(p))
+        if (e.path().extension() == ext) files.push_back(e.path().string());
+    std::sort(files.begin(), files.end());
+    return files;
+  };
+  fs::path root(dir);
+  {
+    std::vector<PolarScan> v;
+    for (const auto& f : sorted(root / "oxford_2019-01-10-14-36-48" / "radar", ".png"))
+      v.push_back(loadOxfordPng(f));
+    if (!v.empty()) out.emplace_back("oxford (real)", std::move(v));
+  }
+  {
+    std::vector<PolarScan> v;
+    for (const auto& f : sorted(root / "mulran", ".csv")) v.push_back(loadMulranCsv(f));
+    if (!v.empty()) out.emplace_back("mulran (real)", std::move(v));
+  }
+  {
+    std::vector<PolarScan> v;
+    fs::path f = root / "boreas_rt" / "test_frame.png";
+    if (fs::exists(f)) v.push_back(loadBoreasPng(f.string()));
+    if (!v.empty()) out.emplace_back("boreas-rt (real)", std::move(v));
+  }
+  {
+    std::vector<PolarScan> v;
+    int64_t t = 0;
+    for (const auto& f : sorted(root / "radiate_fog_6_0" / "Navtech_Polar", ".png")) {
+      v.push_back(loadRadiatePng(f, t));
+      t += 250000000;
+    }
+    if (!v.empty()) out.emplace_back("radiate* (real)", std::move(v));
+  }
+  return out;
+}
+
+std::string formatRealismTable(const std::vector<RealismStats>& cols) {
+  std::ostringstream os;
+  os << std::fixed;
+  os << "| figure |";
+  for (const auto& c : cols) os << ' ' << c.name << " |";
+  os << "\n|---|";
+  for (size_t i = 0; i < cols.size(); ++i) os << "---|";
+  os << "\n";
+  auto row = [&](const char* label, auto get, int prec) {
+    os << "| " << label << " |";
+    for (const auto& c : cols) {
+      double v = get(c);
+      if (v < 0)
+        os << " - |";
+      else
+        os << ' ' << std::setprecision(prec) << v << " |";
+    }
+    os << "\n";
+  };
+  row("scans", [](const RealismStats& c) { return double(c.scans); }, 0);
+  row("zero fraction", [](const RealismStats& c) { return c.zero_fraction; }, 3);
+  row("mean count", [](const RealismStats& c) { return c.mean; }, 1);
+  row("median", [](const RealismStats& c) { return c.q50; }, 0);
+  row("q90", [](const RealismStats& c) { return c.q90; }, 0);
+  row("q99", [](const RealismStats& c) { return c.q99; }, 0);
+  row("q99.9", [](const RealismStats& c) { return c.q999; }, 0);
+  row("max", [](const RealismStats& c) { return c.max; }, 0);
+  row("share >= 40", [](const RealismStats& c) { return c.bright_fraction; }, 4);
+  row("mean 2.5-10 m", [](const RealismStats& c) { return c.band_mean[0]; }, 1);
+  row("mean 10-25 m", [](const RealismStats& c) { return c.band_mean[1]; }, 1);
+  row("mean 25-50 m", [](const RealismStats& c) { return c.band_mean[2]; }, 1);
+  row("mean 50-100 m", [](const RealismStats& c) { return c.band_mean[3]; }, 1);
+  row("azimuth corr (lag 1)", [](const RealismStats& c) { return c.azimuth_corr; }, 3);
+  row("range corr (0.25 m)", [](const RealismStats& c) { return c.range_corr_short; }, 3);
+  row("range corr (1 m)", [](const RealismStats& c) { return c.range_corr_long; }, 3);
+  row("Cen2018 keypoints/scan", [](const RealismStats& c) { return c.detections_cen; }, 0);
+  row("CFAR keypoints/scan", [](const RealismStats& c) { return c.detections_cfar; }, 0);
+  return os.str();
+}
+
+}  // namespace spinradar::sim
