@@ -264,6 +264,18 @@ LocalizationResult Localizer::localizeAgainst(const LocFrame& live, int map_inde
   return r;
 }
 
+bool Localizer::checkAgainstPrior(LocalizationResult& r) const {
+  if (!r.ok) return false;
+  const Eigen::Vector3d d = se2::toXyYaw(se2::inverse(r.T_map_prior) * r.T_map_sensor);
+  if (d.head<2>().norm() <= config_.loc_track_max_offset && std::abs(d(2)) <= config_.loc_track_max_yaw)
+    return true;
+  r.ok = false;
+  r.reason = "estimate too far from the prior (" + std::to_string(d.head<2>().norm()) + " m, " +
+             std::to_string(d(2)) + " rad)";
+  r.T_map_sensor = r.T_map_prior;
+  return false;
+}
+
 LocalizationResult Localizer::globalLocalize(const LocFrame& live, Compensation compensation,
                                              int stride) {
   LocalizationResult best;
@@ -313,8 +325,10 @@ LocalizationResult Localizer::process(const PolarScan& scan, const Eigen::Vector
     const Eigen::Vector3d v =
         cur_live_.has_velocity ? cur_live_.velocity_doppler : Eigen::Vector3d::Zero();
     r = localize(cur_live_, T_last_ * se2::exp(dt * v), comp);
+    checkAgainstPrior(r);
   } else if (have_initial_) {
     r = localize(cur_live_, T_initial_, comp);
+    checkAgainstPrior(r);
   } else {
     r = globalLocalize(cur_live_, comp);
   }

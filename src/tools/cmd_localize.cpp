@@ -205,8 +205,10 @@ void runLocalize(LocalizeArgs& a) {
         const double dt = 1e-9 * static_cast<double>(cur.stamp_ns - m.last_stamp);
         const Eigen::Vector3d v = cur.has_velocity ? cur.velocity_doppler : Eigen::Vector3d::Zero();
         r = loc.localize(cur, m.T_last * se2::exp(dt * v), m.comp);
+        loc.checkAgainstPrior(r);
       } else if (have_initial) {
         r = loc.localize(cur, T_initial, m.comp);
+        loc.checkAgainstPrior(r);
       } else {
         r = loc.globalLocalize(cur, m.comp, a.global_stride);
       }

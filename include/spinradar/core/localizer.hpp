@@ -40,7 +40,9 @@
   X(int, loc_min_inliers, 8, 2, 100000, "", "Fewer RANSAC inliers than this: the scan is not localised") \
   X(double, loc_match_gate, 0.0, 0.0, 1000.0, "m", "Only match keypoints the prior puts this close (0 = off, descriptors only as the paper)") \
   X(double, loc_max_map_distance, 30.0, 0.1, 100000.0, "m", "No map scan this close to the prior: the scan is not localised") \
-  X(double, loc_max_velocity_gap, 1.0, 0.05, 100.0, "s", "A scan's velocity is estimated only with a neighbour this close in time")
+  X(double, loc_max_velocity_gap, 1.0, 0.05, 100.0, "s", "A scan's velocity is estimated only with a neighbour this close in time") \
+  X(double, loc_track_max_offset, 8.0, 0.1, 10000.0, "m", "Tracking: an estimate farther than this from the prediction is rejected") \
+  X(double, loc_track_max_yaw, 0.2, 0.001, 3.2, "rad", "Tracking: an estimate turned more than this from the prediction is rejected")
 // clang-format on
 
 namespace spinradar {
@@ -131,6 +133,10 @@ class Localizer {
   LocalizationResult localizeAgainst(const LocFrame& live, int map_index,
                                      const Eigen::Matrix3d& T_map_prior,
                                      Compensation compensation);
+  /// Tracking check: a result whose pose lies farther than loc_track_max_offset /
+  /// loc_track_max_yaw from its prior is turned into a failure (ok = false, pose = prior,
+  /// reason set). Returns r.ok.
+  bool checkAgainstPrior(LocalizationResult& r) const;
   /// Place recognition without a prior: tries every `stride`-th map frame and keeps the
   /// result with the most inliers.
   LocalizationResult globalLocalize(const LocFrame& live, Compensation compensation,
