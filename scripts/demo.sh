@@ -7,15 +7,18 @@
 # up, and prints latency and CPU per scan for both runs.
 #   SPINRADAR_DEMO_SECONDS  length of the live run in seconds (default 60)
 #   SPINRADAR_DEMO_SCENE    city, out_and_back or tight_turns (default city)
-#   SPINRADAR_DEMO_RATE     bag playback speed factor (default 8)
+#   SPINRADAR_DEMO_RATE     bag playback speed factor (default 25, i.e. 100 scans/s offered)
+#   SPINRADAR_DEMO_SKIP_BUILD=1  use the existing build as is
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-bash "$root/scripts/install_deps.sh"
-bash "$root/scripts/build.sh"
+if [ "${SPINRADAR_DEMO_SKIP_BUILD:-0}" != 1 ]; then
+  bash "$root/scripts/install_deps.sh"
+  bash "$root/scripts/build.sh"
+fi
 build="${SPINRADAR_BUILD_DIR:-$root/build}"
 seconds="${SPINRADAR_DEMO_SECONDS:-60}"
 scene="${SPINRADAR_DEMO_SCENE:-city}"
-play_rate="${SPINRADAR_DEMO_RATE:-8}"
+play_rate="${SPINRADAR_DEMO_RATE:-25}"
 out="$build/demo"
 rm -rf "$out" && mkdir -p "$out"
 export PATH=/usr/bin:$PATH
@@ -44,32 +47,43 @@ echo "[demo] drift of the live odometry against the true trajectory:"
 "$cli" eval --est "$out/live_odom.csv" --gt "$out/truth/trajectory.csv" --step 4 \
   --json "$out/live_eval.json" | tee "$out/live_eval.txt"
 
-echo "[demo] bag playback of the same scans at ${play_rate}x (simulated time)"
-roslaunch spinradar rosbag.launch bag:="$out/live.bag" rate:="$play_rate" delay:=3 \
-  > "$out/playback.log" 2>&1 & play=$!; pids+=($play)
-sleep 2
-rosrun nodelet nodelet load spinradar/PipelineMonitor spinradar_manager __name:=monitor \
-  _odom_csv:="$out/playback_odom.csv" _summary:="$out/playback_summary.json" \
-  > "$out/monitor.log" 2>&1 & mon=$!; pids+=($mon)
-wait "$play" || true
-kill -INT "$mon" 2>/dev/null || true; wait "$mon" 2>/dev/null || true
+echo "[demo] live run on the wall clock (as a real sensor stamps), for latency from the last azimuth"
+roslaunch spinradar sim.launch scene:="$scene" rate:=1 sim_clock:=false port:=$(( sensor_port + 1 )) \
+  monitor:=true summary:="$out/wallclock_summary.json" > "$out/wallclock.log" 2>&1 & wall=$!; pids+=($wall)
+sleep 20
+kill -INT "$wall"; wait "$wall" || true
+
+echo "[demo] bag playback of the live run's scans at ${play_rate}x (simulated time)"
+roslaunch spinradar rosbag.launch bag:="$out/live.bag" rate:="$play_rate" delay:=3 monitor:=true \
+  odom_csv:="$out/playback_odom.csv" summary:="$out/playback_summary.json" \
+  > "$out/playback.log" 2>&1 || true
 
 /usr/bin/python3 - "$out" <<'PY'
 import json, sys
 out = sys.argv[1]
-ev = json.load(open(out + '/live_eval.json'))
-def pick(d, *keys):
-    for k in keys:
-        if isinstance(d, dict) and k in d: return d[k]
-    return None
-print('[demo] ---- summary ----')
-print('[demo] drift against truth: %s' % json.dumps(ev)[:600])
-for name in ('live', 'playback'):
+def load(name):
     try:
-        s = json.load(open('%s/%s_summary.json' % (out, name)))
+        return json.load(open('%s/%s' % (out, name)))
     except (OSError, ValueError):
-        print('[demo] %s: no measurements' % name); continue
-    print('[demo] %-8s %d scans at %.2f Hz, CPU %.1f ms/scan, latency scan message -> odometry '
-          'median %.1f ms (max %.1f)' % (name, s['scans'], s['scan_rate_hz'], s['cpu_ms_per_scan'],
-          s['latency_scan_message_ms']['median'], s['latency_scan_message_ms']['max']))
+        return None
+ev = load('live_eval.json')
+print('[demo] ---- summary ----')
+if ev:
+    e = ev[0]
+    print('[demo] live ROS pipeline on the simulator: %d scans, %.0f m, drift against truth %.2f %% '
+          'and %.4f deg/m (KITTI-style, %d segments of 100-800 m); end-point error %.1f m'
+          % (e['poses'], e['path_length_m'], e['t_err_pct'], e['r_err_deg_per_m'], e['segments'],
+             e['final_error_m']))
+for name, what in (('live', '4 Hz live, simulator clock'), ('wallclock', '4 Hz live, wall clock'),
+                   ('playback', 'bag playback, as fast as it plays')):
+    s = load(name + '_summary.json')
+    if not s or not s.get('scans'):
+        print('[demo] %s: no measurements' % what); continue
+    line = '[demo] %-34s %4d scans at %5.2f Hz: CPU %5.1f ms/scan; scan message -> odometry median %.1f ms (max %.1f)' % (
+        what, s['scans'], s['scan_rate_hz'], s['cpu_ms_per_scan'],
+        s['latency_scan_message_ms']['median'], s['latency_scan_message_ms']['max'])
+    if name == 'wallclock':
+        a = s['latency_last_azimuth_ms']
+        line += '; last azimuth -> odometry median %.1f ms (max %.1f)' % (a['median'], a['max'])
+    print(line)
 PY
