@@ -125,8 +125,8 @@ class Localizer {
   int nearestMapFrame(const Eigen::Vector2d& p) const;
 
   // ---- Localization ---------------------------------------------------------------------
-  /// Localizes a prepared live frame (its velocity set, else compensation is skipped and
-  /// velocity_known is false) against the map frame nearest to the prior.
+  /// Localizes a prepared live frame against the map frame nearest to the prior. A frame
+  /// (live or map) without velocity is used uncompensated; velocity_known is then false.
   LocalizationResult localize(const LocFrame& live, const Eigen::Matrix3d& T_map_prior,
                               Compensation compensation);
   /// Same against a given map frame.
