@@ -82,7 +82,9 @@ class PipelineMonitor : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = pending_.find(toNs(msg->header.stamp));
     if (it != pending_.end()) {
-      if (it->second.scan_end > 0) azimuth_latency_.push_back(now - it->second.scan_end);
+      // Only meaningful when scans carry wall-clock stamps (a live sensor); skip otherwise.
+      const double since_last_azimuth = now - it->second.scan_end;
+      if (since_last_azimuth >= 0 && since_last_azimuth < 60) azimuth_latency_.push_back(since_last_azimuth);
       if (it->second.scan_published > 0) publish_latency_.push_back(now - it->second.scan_published);
       pending_.erase(pending_.begin(), std::next(it));
     }
