@@ -31,7 +31,6 @@ inline Eigen::Matrix<double, 2, 3> dopplerJacobian(double ux, double uy, double 
 bool RefinedEstimator::optimise(Eigen::Vector3d& varpi, Eigen::Matrix3d& cov,
                                 double& chi2_per_dof, int& used) {
   const double beta = config_.beta, sr = config_.range_sigma, sa = config_.azimuth_sigma;
-  const double c2 = kCauchyScale * kCauchyScale;
   const int n = static_cast<int>(x1_.size());
   w_.assign(n, 1.0);
   Eigen::Matrix3d A, P_inv = Eigen::Matrix3d::Zero();
@@ -68,8 +67,7 @@ bool RefinedEstimator::optimise(Eigen::Vector3d& varpi, Eigen::Matrix3d& cov,
           cartesianCovariance(p2, sr, sa) + C * cartesianCovariance(p1, sr, sa) * C.transpose();
       const Eigen::Matrix2d Si = S.inverse();
       const double r2 = e.dot(Si * e);
-      const double w = 1.0 / (1.0 + r2 / c2);  // Cauchy
-      w_[m] = w;
+      const double w = w_[m];  // 1: every gated match (see the header)
       const Eigen::Matrix<double, 3, 2> GtW = w * G.transpose() * Si;
       A.noalias() += GtW * G;
       b.noalias() += GtW * e;
@@ -107,7 +105,7 @@ bool RefinedEstimator::estimate(const FeatureFrame& f1, const FeatureFrame& f2,
   }
   const Eigen::Vector3d xi0 = out.velocity;
   const double beta = config_.beta;
-  const double gate2 = std::pow(kGateFactor * config_.inlier_threshold, 2);
+  const double gate2 = config_.inlier_threshold * config_.inlier_threshold;
   x1_.clear(); y1_.clear(); x2_.clear(); y2_.clear();
   u1x_.clear(); u1y_.clear(); u2x_.clear(); u2y_.clear();
   dt_.clear(); midx_.clear();
@@ -128,7 +126,7 @@ bool RefinedEstimator::estimate(const FeatureFrame& f1, const FeatureFrame& f2,
     midx_.push_back(static_cast<int>(i));
   }
   prior_dt_ = dt_ref;
-  // 2-4. Robust, Doppler-aware, prior-regularised Gauss-Newton.
+  // 2-4. Doppler-aware, prior-regularised Gauss-Newton on the gated matches.
   Eigen::Vector3d varpi = -xi0;
   Eigen::Matrix3d cov;
   double chi2 = 0.0;

@@ -122,7 +122,7 @@ TEST(Odometry, CompoundingFollowsAVaryingDrive) {
 
 TEST(Odometry, RefinedBeatsThePaperEstimators) {
   // Issue 9: on the varying drive with Doppler injected, the refined estimator (Doppler in
-  // the optimisation, two-sided noise model, Cauchy IRLS, lag-free compounding) halves the
+  // the optimisation, two-sided noise model, motion prior, lag-free compounding) halves the
   // final error of mc_doppler; on the arc it is at least as good.
   const DriveResult md = runDrive("mc_doppler", 0.049, driveProfile());
   const DriveResult rf = runDrive("refined", 0.049, driveProfile());

@@ -5,8 +5,11 @@
 //     estimated, p_c(v) = p + beta (u . v) u (u = beam unit vector), both scans.
 //  2. Residual covariance of both endpoints, S_m = R_cart(p_m2) + C_m R_cart(p_m1) C_m^T
 //     (the paper weights by p_m2 only), so far points' tangential noise is weighted right.
-//  3. Cauchy-robust IRLS over every match within a gate around the MC-RANSAC solution
-//     (threshold-free inlier use, moving objects down-weighted instead of hard-cut).
+//  3. The matches within inlier_threshold of the MC-RANSAC solution (with Doppler) are
+//     refitted, all with weight 1. A Cauchy
+//     IRLS over a 3x wider gate was tried and measured worse on the simulator's city route
+//     with full physics (moving cars pull it): KITTI drift 2.58 % / 0.0165 deg/m (Cauchy,
+//     3x gate) and 2.26 % / 0.0152 (Cauchy, 1x gate) against 1.84 % / 0.0126 (this).
 //  4. A weak constant-velocity prior on the change from the previous pair (white-noise
 //     acceleration), which only matters where the geometry is degenerate.
 //  5. Lag-free compounding: a pair's constant velocity describes [t1, t2 + period], centred
@@ -40,8 +43,6 @@ class RefinedEstimator {
   bool estimate(const FeatureFrame& f1, const FeatureFrame& f2, const std::vector<Match>& matches,
                 std::vector<Keypoint>& c1, std::vector<Keypoint>& c2, MotionEstimate& out);
 
-  static constexpr double kGateFactor = 3.0;   ///< gate = kGateFactor * inlier_threshold
-  static constexpr double kCauchyScale = 2.0;  ///< on the whitened residual norm
   static constexpr double kAccelSigma = 3.0;   ///< m/s^2, prior on linear acceleration
   static constexpr double kAngAccelSigma = 1.0;  ///< rad/s^2, prior on angular acceleration
   static constexpr double kStillSpeed = 0.05;  ///< m/s
@@ -59,7 +60,7 @@ class RefinedEstimator {
   // Gated matches, structure of arrays: positions, beam unit vectors, dt.
   std::vector<double> x1_, y1_, x2_, y2_, u1x_, u1y_, u2x_, u2y_, dt_;
   std::vector<int> midx_;  ///< match index of each gated entry
-  std::vector<double> w_;  ///< final robust weights
+  std::vector<double> w_;  ///< per-match weights (all 1; kept for a robust kernel)
 };
 
 }  // namespace spinradar
