@@ -29,12 +29,18 @@ void ScanAssembler::reset() {
   in_rotation_ = false;
   first_after_reset_ = true;
   last_encoder_ = -1;
+  phase_ = -1;
 }
 
-int ScanAssembler::rowOf(uint16_t encoder) const {
-  const int n = config_.azimuth_samples, e = config_.encoder_size;
-  // Nearest row; encoder values just below the wrap belong to the last row, not to row 0.
-  return std::min(n - 1, int((int64_t(encoder) * n + e / 2) / e));
+int ScanAssembler::rowOf(uint16_t encoder) {
+  const int n = config_.azimuth_samples;
+  const double step = double(config_.encoder_size) / n;
+  // Sensors report azimuths at a fixed phase within each encoder step (Oxford CIR204-H data:
+  // 13, 27, 41, ..., 5599; the emulator: 0, 14, 28, ...). Learn it from the first azimuth so
+  // row a is the a-th azimuth of the rotation whatever the phase, then take the nearest row.
+  if (phase_ < 0) phase_ = std::fmod(double(encoder), step);
+  const long r = std::lround(std::floor((encoder - phase_) / step + 0.5));
+  return int(((r % n) + n) % n);
 }
 
 void ScanAssembler::begin(int bins, int bit_depth) {
@@ -136,7 +142,8 @@ bool ScanAssembler::finish(AssembledScan& out) {
       continue;
     }
     if (filled_[a] == 2) continue;  // keeps the first copy's encoder and stamp
-    s.encoder[a] = uint16_t((int64_t(a) * config_.encoder_size + n / 2) / n);
+    s.encoder[a] = uint16_t(std::lround(phase_ + double(a) * config_.encoder_size / n) %
+                            config_.encoder_size);
     s.azimuth[a] = 2.0 * M_PI * s.encoder[a] / config_.encoder_size;
     int next = a + 1;
     while (next < n && filled_[next] != 1) ++next;

@@ -228,3 +228,25 @@ TEST(NavtechAssembler, NoDataBeforeConfiguration) {
   a.setConfiguration(bad);
   EXPECT_FALSE(a.hasConfiguration());
 }
+
+TEST(NavtechAssembler, EncoderPhaseOfRealSensorKeepsRowOrder) {
+  // Oxford CIR204-H data reports encoders 13, 27, ..., 5599 (phase 13 of a 14-count step).
+  Configuration c = smallConfig(400, 5600);
+  ScanAssembler a;
+  a.setConfiguration(c);
+  AssembledScan s;
+  bool done = false;
+  for (int r = 0; r < 400; ++r) {
+    if (r == 200) continue;  // one lost azimuth
+    done = a.add(msg(14 * r + 13, uint16_t(r % 256)), r, r, s);
+  }
+  ASSERT_TRUE(done);  // closed on row 399 = encoder 5599
+  EXPECT_EQ(s.missing, 1);
+  EXPECT_EQ(s.duplicated, 0);
+  EXPECT_EQ(s.scan.encoder[0], 13);
+  EXPECT_EQ(s.scan.row(0)[0], 0);
+  EXPECT_EQ(s.scan.row(399)[0], 399 % 256);
+  EXPECT_EQ(s.scan.valid[200], 0);
+  EXPECT_EQ(s.scan.encoder[200], 14 * 200 + 13);  // the hole gets the encoder it should have had
+  EXPECT_EQ(s.scan.row(201)[0], 201 % 256);
+}

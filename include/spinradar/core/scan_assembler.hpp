@@ -1,10 +1,11 @@
 #pragma once
 // Azimuth messages -> one PolarScan per rotation.
 //
-// Rows are placed by encoder value, row = round(encoder * azimuths / encoder_size) mod
-// azimuths, never by arrival order, so a lost message leaves a hole (valid = 0) instead of
-// shifting every later row. A row that arrives twice keeps its first data and is marked
-// valid = 0 (which of the two is right cannot be known). A rotation closes when its last row
+// Rows are placed by encoder value, never by arrival order: row = nearest multiple of the
+// encoder step (encoder_size / azimuths) after removing the phase at which the sensor reports
+// (learned from the first azimuth after a reset: real CIR204-H data reads 13, 27, ..., 5599),
+// so a lost message leaves a hole (valid = 0) instead of shifting every later row. A row that
+// arrives twice keeps its first data and is marked valid = 0 (which copy is right is unknown). A rotation closes when its last row
 // arrives (lowest latency) or when the encoder wraps (value smaller than the previous one).
 // Missing rows get the encoder and angle they should have had, zero power, and a stamp
 // interpolated from their valid neighbours so stamps stay monotonic.
@@ -70,7 +71,7 @@ class ScanAssembler {
  private:
   void begin(int bins, int bit_depth);
   bool finish(AssembledScan& out);
-  int rowOf(uint16_t encoder) const;
+  int rowOf(uint16_t encoder);
 
   AssemblerOptions opt_;
   Configuration config_;
@@ -81,6 +82,7 @@ class ScanAssembler {
   bool first_after_reset_ = true;
   int first_row_ = 0;
   int last_encoder_ = -1;
+  double phase_ = -1;  ///< encoder phase of row 0 within one step, learned after a reset
   int64_t last_receive_ns_ = 0;
   uint64_t sequence_ = 0;
   AssemblerStats stats_;
