@@ -162,7 +162,7 @@ void runLocalize(LocalizeArgs& a) {
     m->csv.open(m->path);
     if (!m->csv) throw std::runtime_error(m->path + ": cannot write");
     m->csv << "t,x,y,yaw,ok,map_t,matches,inliers,velocity_known" << (truth.empty() ? "" : ",err_trans,err_rot_deg") << "\n";
-    m->csv << std::setprecision(10);
+    m->csv << std::fixed << std::setprecision(6);  // UNIX-time stamps need the decimals
     modes.push_back(std::move(m));
   }
   const bool have_initial = !a.initial_pose.empty();
