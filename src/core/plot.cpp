@@ -330,8 +330,21 @@ cv::Mat Plot::render(int width, int height) const {
     }
     if (!entries.empty()) {
       const int row_h = 18, sample_w = 26;
-      const cv::Rect box(area.x + area.width - text_w - sample_w - 22, area.y + 8,
-                         text_w + sample_w + 14, row_h * static_cast<int>(entries.size()) + 8);
+      const int bw = text_w + sample_w + 14, bh = row_h * static_cast<int>(entries.size()) + 8;
+      // The corner covering the fewest data points (top right on ties).
+      const cv::Rect corners[4] = {
+          {area.x + area.width - bw - 8, area.y + 8, bw, bh},
+          {area.x + 8, area.y + 8, bw, bh},
+          {area.x + area.width - bw - 8, area.y + area.height - bh - 8, bw, bh},
+          {area.x + 8, area.y + area.height - bh - 8, bw, bh}};
+      int hits[4] = {0, 0, 0, 0};
+      for (const auto& s : series_)
+        for (size_t i = 0; i < s.x.size(); ++i) {
+          if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+          const cv::Point p(static_cast<int>(px(s.x[i])), static_cast<int>(py(s.y[i])));
+          for (int c = 0; c < 4; ++c) hits[c] += corners[c].contains(p);
+        }
+      const cv::Rect box = corners[std::min_element(hits, hits + 4) - hits];
       cv::rectangle(img, box, kWhite, cv::FILLED);
       cv::rectangle(img, box, cv::Scalar(160, 160, 160), 1);
       for (size_t e = 0; e < entries.size(); ++e) {
