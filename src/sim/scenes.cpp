@@ -35,7 +35,7 @@ void addClutter(World& w, Rng& rng, double x0, double y0, double x1, double y1, 
   for (int i = 0; i < n; ++i) {
     double x = uni(rng, x0, x1), y = uni(rng, y0, y1);
     if (!keep(x, y)) continue;
-    w.targets.push_back({x, y, -42.0 + 7.0 * rng.normal(), 0, 0});
+    w.targets.push_back({x, y, -40.0 + 7.0 * rng.normal(), 0, 0});
   }
 }
 
@@ -175,12 +175,16 @@ Scene city(uint64_t variant, double t0) {
       }
 
   // Ground clutter in the streets and front yards, trees along the kerbs.
-  auto in_street = [&](double x, double y) {
+  // Kerbs, verges and front yards: 4.5-9.5 m from a street's centre line (not the carriageway).
+  auto verge = [&](double x, double y) {
     double mx = std::fmod(x + P, P), my = std::fmod(y + P, P);
-    return mx < half_street + 2.5 || mx > P - half_street - 2.5 || my < half_street + 2.5 ||
-           my > P - half_street - 2.5;
+    double dx = std::min(mx, P - mx), dy = std::min(my, P - my);
+    bool near_x = dx < half_street + 2.5, near_y = dy < half_street + 2.5;
+    if (!near_x && !near_y) return false;
+    if ((near_x && dx < 4.5) || (near_y && dy < 4.5)) return false;
+    return true;
   };
-  addClutter(w, rng, -40, -40, G * P + 40, G * P + 40, 0.25, in_street);
+  addClutter(w, rng, -40, -40, G * P + 40, G * P + 40, 0.3, verge);
   for (int k = 0; k <= G; ++k)
     for (int side = -1; side <= 1; side += 2)
       for (double u = uni(rng, 0, 20); u < G * P; u += uni(rng, 15, 45)) {
@@ -249,7 +253,7 @@ Scene outAndBack(uint64_t variant, double t0) {
     for (double x = uni(rng, -30, 0); x < L + 40; x += uni(rng, 10, 40))
       addTree(w, rng, x, side * uni(rng, 9, 40), uni(rng, 1.0, 3.0));
   }
-  addClutter(w, rng, -60, -60, L + 60, 60, 0.08, [](double, double y) { return std::abs(y) > 3.5; });
+  addClutter(w, rng, -60, -60, L + 60, 60, 0.12, [](double, double y) { return std::abs(y) > 5.0; });
   Route route;
   route.leg(300, 15.0, 15.0, 2.0, 2.0);
   route.leg(300, 20.0, 20.0, 1.5, 2.0);
@@ -285,7 +289,7 @@ Scene tightTurns(uint64_t variant, double t0) {
     double r = uni(rng, 30, 120), a = uni(rng, 0, 2 * M_PI);
     addTree(w, rng, 60 + r * std::cos(a), r * std::sin(a), uni(rng, 1.0, 3.0));
   }
-  addClutter(w, rng, -70, -130, 190, 130, 0.06, [](double, double) { return true; });
+  addClutter(w, rng, -70, -130, 190, 130, 0.08, [](double, double) { return true; });
   // Perimeter fence with gaps.
   const double X0 = -70, X1 = 190, Y0 = -130, Y1 = 130;
   auto fence = [&](double x1, double y1, double x2, double y2) {

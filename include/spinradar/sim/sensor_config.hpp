@@ -19,9 +19,9 @@
   X(double, power_scale, 1.0, 0.1, 10.0, "count/dB", "Output counts per dB (Navtech: about 1)") \
   X(double, saturation, 255.0, 1.0, 255.0, "count", "Largest output value") \
   X(double, min_range, 0.5, 0.0, 50.0, "m", "Returns closer than this are not rendered") \
-  X(double, radar_constant_db, 95.0, 0.0, 300.0, "dB", "Received power of a 0 dBsm point at 1 m before range gain") \
+  X(double, radar_constant_db, 103.0, 0.0, 300.0, "dB", "Received power of a 0 dBsm point at 1 m before range gain") \
   X(double, noise_range_slope_db_per_decade, 0.0, -40.0, 40.0, "dB/dec", "Noise floor change per decade of range (from 10 m)") \
-  X(double, clutter_db, 4.0, 0.0, 80.0, "dB", "Diffuse ground clutter power at 10 m, above the noise floor") \
+  X(double, clutter_db, 2.0, 0.0, 80.0, "dB", "Diffuse ground clutter power at 10 m, above the noise floor") \
   X(double, clutter_db_per_decade, -14.0, -60.0, 0.0, "dB/dec", "Ground clutter change per decade of range") \
   X(double, range_psf_sigma_bins, 2.7, 0.3, 20.0, "bins", "Std of the Gaussian-like range mainlobe in power (real CTS350-X/CIR204: ~2.7)") \
   X(double, range_sidelobe_db, -60.0, -120.0, -10.0, "dB", "FFT-window range sidelobe level (decaying as offset^-3)") \
