@@ -128,3 +128,20 @@ TEST(SimRender, BuiltinScenesLookLikeRealScans) {
   EXPECT_GT(st.azimuth_corr, 0.6);
   EXPECT_GT(st.range_corr_short, 0.7);
 }
+
+TEST(SimRender, MultipathGhostAppearsAtTheMirrorImage) {
+  // Target at (30, 5), wall along y = 10 (beside it): the double-bounce ghost is the mirror
+  // image (30, 15), seen through the wall.
+  World w = oneTarget(30, 5, 30);
+  w.walls.push_back({0, 10, 60, 10, -30});
+  PhysicsConfig p = PhysicsConfig::fromJson(nlohmann::json::parse(R"({"multipath": -10})"));
+  Simulator with(w, constantMotion(0, 0), SensorConfig{}, p, 1);
+  Simulator without(w, constantMotion(0, 0), SensorConfig{}, PhysicsConfig{}, 1);
+  double psi = 2 * M_PI - std::atan2(15.0, 30.0);  // clockwise azimuth of the ghost
+  int a = int(std::lround(psi / (2 * M_PI / 400))) % 400;
+  PolarScan s1 = with.renderScan(0), s0 = without.renderScan(0);
+  int b = int(s1.binOfRange(std::hypot(30.0, 15.0)));
+  int ghost = findPeak(s1, a - 1, a + 1, b - 4, b + 4).value;
+  int none = findPeak(s0, a - 1, a + 1, b - 4, b + 4).value;
+  EXPECT_GT(ghost, none + 20);
+}
