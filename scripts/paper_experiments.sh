@@ -99,17 +99,6 @@ PY
 echo
 echo "(details: $out/odometry_eval.txt, plots: $out/odometry.png)"
 
-# --- Table II: localization against a reverse drive (localization issue) ---
+# --- Table II: localization against a reverse drive (scripts/localization_experiment.sh) ---
 echo
-if "$bin" localize --help > /dev/null 2>&1; then
-  if [[ -x "$root/scripts/paper_localization.sh" ]]; then
-    SPINRADAR_BIN="$bin" bash "$root/scripts/paper_localization.sh" "$out"
-  else
-    echo "Table II: 'spinradar localize' exists but scripts/paper_localization.sh (the hook this"
-    echo "script calls with SPINRADAR_BIN and OUT_DIR) does not yet."
-  fi
-else
-  echo "Table II (metric localization against a reverse drive): not available yet. It needs"
-  echo "'spinradar localize' from the localization issue; this script then calls"
-  echo "scripts/paper_localization.sh with SPINRADAR_BIN and OUT_DIR set (hook)."
-fi
+SPINRADAR_BIN="$bin" bash "$root/scripts/localization_experiment.sh" "$out/localization"
