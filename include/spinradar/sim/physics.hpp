@@ -2,6 +2,17 @@
 // The physics configuration: JSON object from effect name to value, absent meaning off.
 // {"motion_distortion": true, "doppler": 0.049, "timestamp_offset": 0.03,
 //  "azimuth_offset": 0.0105, "range_offset": -0.3, "moving_objects": true}
+// Extra effects of this simulator (keys in `extra`):
+//   "stamp_bursts": true | {"size": 16, "spacing": 135e-6, "delay": 0}  per-azimuth stamps
+//       arrive in packets (Oxford/MulRan): row i of a packet is stamped at the acquisition time
+//       of the packet's last row + delay + i * spacing
+//   "rotation_jitter": s   relative std of the rotation period per scan; true firing times
+//       stretch, stamps stay nominal
+//   "encoder_wobble": rad  true angle -= A sin(reported angle)
+//   "multipath": dB (or true = -15)  double-bounce ghosts of point targets mirrored in walls
+//   "attenuation": dB/km   two-way path loss (rain, fog)
+//   "chirp_alternate": true  Boreas-RT style: Doppler sign flips on alternate azimuths
+//   "scan_pose_time": "mid" | "start"  pose used when motion_distortion is off
 #include <string>
 #include <vector>
 

@@ -11,6 +11,20 @@
 
 namespace spinradar::sim {
 
+/// Conventions (see also physics.hpp):
+/// - Azimuth a of scan k is acquired at t0 + a / (azimuths * rotation_hz) (true time) and
+///   reported at that time + timestamp_offset (stamp_ns = llround(t * 1e9)); encoder =
+///   a * encoder_size / azimuths; reported angle = encoder angle; true beam angle = reported -
+///   azimuth_offset.
+/// - motion_distortion on: each azimuth from the pose (and velocity) at its own time; off: the
+///   whole rotation from the pose at MID-scan, t0 + 0.5 / rotation_hz (extra key
+///   "scan_pose_time": "start" selects t0 instead).
+/// - moving_objects off: targets with a velocity are left out (the static world is rendered).
+/// - Doppler: apparent range r - beta * u, u = closing speed (sensor minus target velocity
+///   along the beam); with "chirp_alternate" the sign flips on odd azimuths (chirp_up = 0).
+/// - Noise is a function of (seed, scan) only: renderScan(k) is deterministic and const, and
+///   safe to call from several threads at once (per-thread work buffers).
+/// - Speed: 25-70 full 400 x 3768 rotations per second on one core for the built-in scenes.
 class Simulator {
  public:
   Simulator(World world, Trajectory trajectory, SensorConfig sensor, PhysicsConfig physics,
