@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <cmath>
 #include <sstream>
 
@@ -44,8 +45,31 @@ std::vector<Measured> measureSimulated(const sim::Simulator& sim, const PolarSca
   return out;
 }
 
-ResidualStats stats(const std::vector<Observation>& obs, const std::vector<double>& er,
-                    const std::vector<double>& eaz, const std::vector<bool>& use, double sweep) {
+// With target positions as nuisance, residual figures are taken after removing each
+// target's mean residual (what refitting its position would absorb).
+bool g_demean_targets = false;
+
+void demeanByTarget(const std::vector<Observation>& obs, std::vector<double>& er,
+                    std::vector<double>& eaz, const std::vector<bool>& use) {
+  std::map<int, std::array<double, 3>> acc;
+  for (size_t i = 0; i < obs.size(); ++i) {
+    if (!use[i] || !std::isfinite(er[i])) continue;
+    auto& a = acc[obs[i].target];
+    a[0] += er[i];
+    a[1] += eaz[i];
+    a[2] += 1;
+  }
+  for (size_t i = 0; i < obs.size(); ++i) {
+    auto it = acc.find(obs[i].target);
+    if (it == acc.end() || !std::isfinite(er[i])) continue;
+    er[i] -= it->second[0] / it->second[2];
+    eaz[i] -= it->second[1] / it->second[2];
+  }
+}
+
+ResidualStats stats(const std::vector<Observation>& obs, std::vector<double> er,
+                    std::vector<double> eaz, const std::vector<bool>& use, double sweep) {
+  if (g_demean_targets) demeanByTarget(obs, er, eaz, use);
   ResidualStats s;
   double sp = 0, sr = 0, sa = 0;
   for (size_t i = 0; i < obs.size(); ++i) {
@@ -72,14 +96,21 @@ struct Design {
 };
 
 Design buildDesign(const std::vector<Observation>& obs, const std::vector<Effect>& cands,
-                   double sr, double sa, int n_scans) {
+                   double sr, double sa, int n_scans, bool target_nuisance) {
   Design d;
   std::vector<int> idx;
   for (size_t i = 0; i < obs.size(); ++i)
     if (obs[i].inlier) idx.push_back(static_cast<int>(i));
   const int m = static_cast<int>(idx.size());
+  std::map<int, int> tcol;  // target -> first nuisance column
+  if (target_nuisance)
+    for (int i : idx)
+      if (!tcol.count(obs[i].target)) {
+        const int c = static_cast<int>(2 * tcol.size());
+        tcol[obs[i].target] = c;
+      }
   d.y.resize(2 * m);
-  d.N.resize(2 * m, 0);
+  d.N = Eigen::MatrixXd::Zero(2 * m, static_cast<int>(2 * tcol.size()));
   d.C.resize(2 * m, static_cast<int>(cands.size()));
   d.A = Eigen::MatrixXd::Zero(2 * m, 3 * n_scans);
   for (int j = 0; j < m; ++j) {
@@ -90,6 +121,13 @@ Design buildDesign(const std::vector<Observation>& obs, const std::vector<Effect
       const int e = static_cast<int>(cands[k]);
       d.C(j, k) = o.dr[e] / sr;
       d.C(m + j, k) = o.daz[e] / sa;
+    }
+    if (target_nuisance) {
+      const int c = tcol[o.target];
+      for (int q = 0; q < 2; ++q) {
+        d.N(j, c + q) = o.tr[q] / sr;
+        d.N(m + j, c + q) = o.taz[q] / sa;
+      }
     }
     for (int q = 0; q < 3; ++q) {
       d.A(j, 3 * o.scan + q) = o.nr[q] / sr;
@@ -128,6 +166,7 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
   const auto t_start = std::chrono::steady_clock::now();
   DiagnoseReport rep;
   rep.base = in.base;
+  g_demean_targets = opt.target_nuisance;
   rep.scans = static_cast<int>(in.scans.size());
   if (in.scans.empty()) throw std::runtime_error("diagnose: the recording holds no scans");
 
@@ -186,6 +225,13 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
         o.nr[q] = (pq.range - v.pred.range) / steps[q];
         o.naz[q] = wrapPi(pq.azimuth - v.pred.azimuth) / steps[q];
       }
+      for (int q = 0; q < 2; ++q) {
+        sim::Target moved = tg;
+        (q == 0 ? moved.x : moved.y) += hp;
+        const Prediction pq = predictTarget(moved, geo, in.trajectory, in.base, opt.conventions);
+        o.tr[q] = (pq.range - v.pred.range) / hp;
+        o.taz[q] = wrapPi(pq.azimuth - v.pred.azimuth) / hp;
+      }
       cand_obs.push_back(o);
       gates.push_back(v.gate);
     }
@@ -236,7 +282,7 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
   SelectionResult sel;
   Design d;
   for (int pass = 0; pass < 2; ++pass) {
-    d = buildDesign(rep.obs, cands, sr, sa, rep.scans);
+    d = buildDesign(rep.obs, cands, sr, sa, rep.scans, opt.target_nuisance);
     sel = stepwiseSelect(d.y, d.N, d.C, so);
     // Residuals of every observation under the joint fit.
     std::vector<double> rr, ra;
@@ -244,11 +290,22 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
       double fr = o.e_r, fa = o.e_az;
       for (size_t i = 0; i < sel.selected.size(); ++i) {
         const int e = static_cast<int>(cands[sel.selected[i]]);
-        fr -= sel.joint.coef(i) * o.dr[e];
-        fa -= sel.joint.coef(i) * o.daz[e];
+        fr -= sel.joint.coef(d.N.cols() + i) * o.dr[e];
+        fa -= sel.joint.coef(d.N.cols() + i) * o.daz[e];
       }
       o.fit_r = fr;
       o.fit_az = fa;
+    }
+    // Inliers: the joint fit's residuals (they include the nuisance part).
+    {
+      const int m = static_cast<int>(d.rows.size());
+      for (int j = 0; j < m; ++j) {
+        rep.obs[d.rows[j]].fit_r = sel.joint.resid(j) * sr;
+        rep.obs[d.rows[j]].fit_az = sel.joint.resid(m + j) * sa;
+      }
+    }
+    for (auto& o : rep.obs) {
+      const double fr = o.fit_r, fa = o.fit_az;
       if (o.inlier) {
         rr.push_back(fr);
         ra.push_back(fa);

@@ -108,6 +108,7 @@ nlohmann::json DiagnoseReport::toJson() const {
                {"sigma_range_m", sigma_r},
                {"sigma_azimuth_rad", sigma_az},
                {"effects_tested", effect_names_tested}};
+  j["scene_model"] = scene_model;
   j["runtime_s"] = runtime_s;
   return j;
 }
@@ -119,6 +120,7 @@ std::string DiagnoseReport::summaryMarkdown() const {
     << " (" << scans << " scans, " << obs.size() << " target returns of " << targets_used
     << " targets, " << outliers << " outliers dropped; family-wise alpha with Holm correction "
     << "and BIC).\n\n";
+  s << "Scene model: " << scene_model << ".\n\n";
   s << "Residual RMS (position, re-simulated): " << fmt(before.position_rms) << " m before, "
     << fmt(after.position_rms) << " m after. Range " << fmt(before.range_rms) << " -> "
     << fmt(after.range_rms) << " m, azimuth " << fmt(before.azimuth_rms * 180 / M_PI) << " -> "

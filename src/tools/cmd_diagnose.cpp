@@ -14,7 +14,7 @@ namespace fs = std::filesystem;
 using namespace spinradar;
 
 struct DiagnoseArgs {
-  std::string recording, trajectory, world, base, out;
+  std::string recording, trajectory, world, base, out, map_split = "early-late";
   double range_resolution = 0;  // 0: sensor.json or the default
   int first_scan = 0, max_scans = -1;
   double alpha = 0.001;
@@ -51,7 +51,7 @@ void run(const DiagnoseArgs& a) {
                                      : std::min(folder.size(), size_t(a.first_scan + a.max_scans));
   for (size_t i = a.first_scan; i < end; ++i) in.scans.push_back(folder.load(i));
   if (in.scans.empty()) throw std::runtime_error(a.recording + ": no scans in the chosen range");
-  in.world = sim::World::load(a.world);
+  if (!a.world.empty()) in.world = sim::World::load(a.world);
   in.trajectory = sim::Trajectory::loadCsv(a.trajectory);
   in.sensor = sensorFor(a, in.scans);
   if (!a.base.empty()) in.base = sim::PhysicsConfig::load(a.base);
@@ -61,7 +61,9 @@ void run(const DiagnoseArgs& a) {
   opt.alpha = a.alpha;
   opt.seed = a.seed;
   opt.resimulate_after = !a.no_resimulate;
-  const diagnose::DiagnoseReport rep = diagnose::diagnose(in, opt);
+  const diagnose::DiagnoseReport rep = a.world.empty()
+                                           ? diagnose::diagnoseWithoutWorld(in, opt, a.map_split)
+                                           : diagnose::diagnose(in, opt);
   diagnose::writeReport(rep, a.out);
   std::cout << (rep.mismatch_found ? "mismatch found:" : "no significant mismatch");
   for (const auto& e : rep.effects)
@@ -82,7 +84,11 @@ SPINRADAR_COMMAND(
           ->required();
       app.add_option("--trajectory", a->trajectory, "Sensor trajectory CSV t,x,y,yaw")
           ->required();
-      app.add_option("--world", a->world, "World JSON (targets, walls)")->required();
+      app.add_option("--world", a->world,
+                     "World JSON (targets, walls); without it the scene is mapped from part of "
+                     "the recording (--map-split)");
+      app.add_option("--map-split", a->map_split,
+                     "Without --world: early-late, late-early or out-back (which scans map)");
       app.add_option("--base", a->base,
                      "Physics JSON the simulation uses (default: no effects)");
       app.add_option("--range-resolution", a->range_resolution,

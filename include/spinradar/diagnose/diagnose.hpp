@@ -35,6 +35,9 @@ struct DiagnoseOptions {
   double outlier_sigma = 5.0;     ///< residuals beyond this many robust sigmas are dropped
   uint64_t seed = 97;             ///< re-simulation noise seed
   bool resimulate_after = true;   ///< re-render with the fitted effects (before/after)
+  /// Treat every target's world position as a nuisance parameter (2 per target): for scene
+  /// models mapped from the recording, whose positions carry the effect's average.
+  bool target_nuisance = false;
   ModelConventions conventions;
   ViewOptions views;
   PeakOptions peaks;
@@ -51,6 +54,7 @@ struct Observation {
   double e_r = 0, e_az = 0;       ///< real minus re-simulated (m, rad)
   std::array<double, kNumEffects> dr{}, daz{};  ///< d(range, azimuth)/d(parameter)
   std::array<double, 3> nr{}, naz{};            ///< d(range, azimuth)/d(sensor dx, dy, dyaw)
+  std::array<double, 2> tr{}, taz{};            ///< d(range, azimuth)/d(target x, y)
   double fit_r = 0, fit_az = 0;   ///< residual after the fitted linear model
   bool inlier = true;
   double radialVelocity() const;  ///< sensor velocity along the ray (m/s)
@@ -108,11 +112,17 @@ struct DiagnoseReport {
   int scans = 0, targets_used = 0, outliers = 0;
   double sigma_r = 0, sigma_az = 0;      ///< robust noise of one residual
   double runtime_s = 0;
+  std::string scene_model = "world file";  ///< or how the map was built from the recording
   nlohmann::json toJson() const;
   std::string summaryMarkdown() const;
 };
 
 DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt = {});
+
+/// Without a world file (in.world ignored): builds the static scene from part of the recording
+/// (`split`: "early-late", "late-early", "out-back"; see scene_map.hpp) and diagnoses the rest.
+DiagnoseReport diagnoseWithoutWorld(const DiagnoseInput& in, const DiagnoseOptions& opt = {},
+                                    const std::string& split = "early-late");
 
 /// Writes report.json, summary.md, summary.txt and PNG plots into out_dir (created).
 void writeReport(const DiagnoseReport& report, const std::string& out_dir);
