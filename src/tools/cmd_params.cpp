@@ -4,7 +4,11 @@
 #include <type_traits>
 
 #include "command.hpp"
+#include "spinradar/core/driver_config.hpp"
+#include "spinradar/core/localizer.hpp"
 #include "spinradar/core/params.hpp"
+#include "spinradar/core/rsd.hpp"
+#include "spinradar/sim/sensor_config.hpp"
 
 namespace {
 
@@ -37,5 +41,9 @@ SPINRADAR_COMMAND("params", "Print every parameter with default, range, unit and
                       printTable("detector", c.detector);
                       printTable("features", c.features);
                       printTable("estimator", c.estimator);
+                      printTable("localizer", spinradar::LocalizerConfig{});
+                      printTable("rsd", spinradar::RsdConfig{});
+                      printTable("driver", spinradar::DriverConfig{});
+                      printTable("sim sensor", spinradar::sim::SensorConfig{});
                     });
                   });
