@@ -45,10 +45,6 @@ std::vector<Measured> measureSimulated(const sim::Simulator& sim, const PolarSca
   return out;
 }
 
-// With target positions as nuisance, residual figures are taken after removing each
-// target's mean residual (what refitting its position would absorb).
-bool g_demean_targets = false;
-
 void demeanByTarget(const std::vector<Observation>& obs, std::vector<double>& er,
                     std::vector<double>& eaz, const std::vector<bool>& use) {
   std::map<int, std::array<double, 3>> acc;
@@ -67,9 +63,11 @@ void demeanByTarget(const std::vector<Observation>& obs, std::vector<double>& er
   }
 }
 
-ResidualStats stats(const std::vector<Observation>& obs, std::vector<double> er,
+// With target positions as nuisance (demean), residual figures are taken after removing each
+// target's mean residual (what refitting its position would absorb).
+ResidualStats stats(bool demean, const std::vector<Observation>& obs, std::vector<double> er,
                     std::vector<double> eaz, const std::vector<bool>& use, double sweep) {
-  if (g_demean_targets) demeanByTarget(obs, er, eaz, use);
+  if (demean) demeanByTarget(obs, er, eaz, use);
   ResidualStats s;
   double sp = 0, sr = 0, sa = 0;
   for (size_t i = 0; i < obs.size(); ++i) {
@@ -166,7 +164,6 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
   const auto t_start = std::chrono::steady_clock::now();
   DiagnoseReport rep;
   rep.base = in.base;
-  g_demean_targets = opt.target_nuisance;
   rep.scans = static_cast<int>(in.scans.size());
   if (in.scans.empty()) throw std::runtime_error("diagnose: the recording holds no scans");
 
@@ -443,7 +440,7 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
       r0.push_back(o.e_r);
       a0.push_back(o.e_az);
     }
-    rep.before = stats(rep.obs, r0, a0, use, sweep);
+    rep.before = stats(opt.target_nuisance, rep.obs, r0, a0, use, sweep);
   }
   rep.after = rep.before;
   if (opt.resimulate_after && !rep.effects.empty()) {
@@ -501,8 +498,8 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
         if (std::fabs(er_s[i]) > opt.outlier_sigma * sr_j ||
             std::fabs(ea_s[i]) > opt.outlier_sigma * sa_j)
           use_j[i] = false;
-      const ResidualStats after = stats(rep.obs, er_s, ea_s, use_j, sweep);
-      const ResidualStats before = stats(rep.obs, prev_er, prev_ea, use_j, sweep);
+      const ResidualStats after = stats(opt.target_nuisance, rep.obs, er_s, ea_s, use_j, sweep);
+      const ResidualStats before = stats(opt.target_nuisance, rep.obs, prev_er, prev_ea, use_j, sweep);
       EffectResult rj = rep.effects[j];
       rj.residual_rms_before = before.position_rms;
       rj.residual_rms_after = after.position_rms;
@@ -532,7 +529,7 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
     rep.mismatch_found = !rep.effects.empty();
     if (!rep.after_step.empty()) {
       std::vector<bool> all = use;
-      rep.after = stats(rep.obs, prev_er, prev_ea, all, sweep);
+      rep.after = stats(opt.target_nuisance, rep.obs, prev_er, prev_ea, all, sweep);
     }
   } else {
     // No re-simulation: the linear model's residuals stand in for the "after" figures.
@@ -541,7 +538,7 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
       fr.push_back(o.fit_r);
       fa.push_back(o.fit_az);
     }
-    rep.after = stats(rep.obs, fr, fa, use, sweep);
+    rep.after = stats(opt.target_nuisance, rep.obs, fr, fa, use, sweep);
     for (auto& r : rep.effects) {
       r.residual_rms_before = rep.before.position_rms;
       r.residual_rms_after = rep.after.position_rms;
