@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "scan_io_detail.hpp"
 #include "spinradar/core/scan_io.hpp"
 
@@ -23,6 +25,17 @@ bool pngSize(const std::string& path, int& width, int& height) {
   if (h[0] != 0x89 || h[1] != 'P' || h[2] != 'N' || h[3] != 'G') return false;
   width = (h[16] << 24) | (h[17] << 16) | (h[18] << 8) | h[19];
   height = (h[20] << 24) | (h[21] << 16) | (h[22] << 8) | h[23];
+  return true;
+}
+
+/// First row's embedded microsecond stamp of a Navtech-layout PNG (columns 0-7, int64 LE), for
+/// files whose name is not a stamp (e.g. Boreas-RT's test_frame.png).
+bool embeddedStampNs(const std::string& path, int64_t& ns) {
+  const cv::Mat img = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (img.empty() || img.type() != CV_8UC1 || img.cols < 8) return false;
+  int64_t us = 0;
+  for (int k = 7; k >= 0; --k) us = (us << 8) | img.at<uint8_t>(0, k);
+  ns = us * 1000;
   return true;
 }
 
@@ -151,6 +164,12 @@ ScanFolder::ScanFolder(const std::string& folder, ScanFormat format, ScanFolderO
   files_.reserve(names.size());
   for (const auto& p : names) {
     long long num = 0;
+    const bool navtech_png = format_ == ScanFormat::Oxford || format_ == ScanFormat::Boreas;
+    int64_t embedded_ns = 0;
+    if (!detail::stemNumber(p, num) && navtech_png && embeddedStampNs(p, embedded_ns)) {
+      files_.push_back({p, embedded_ns});
+      continue;
+    }
     if (!detail::stemNumber(p, num))
       throw std::runtime_error(folder + ": file name " + fs::path(p).filename().string() +
                                " is not a number (time stamp or frame index expected)");

@@ -112,3 +112,15 @@ TEST(RealData, RadiateFolder) {
   EXPECT_EQ(inner.format(), ScanFormat::Radiate);
   EXPECT_EQ(inner.fileStampNs(0), folder.fileStampNs(0));
 }
+
+// A Navtech-layout PNG whose name is not a stamp (Boreas-RT's test_frame.png) is listed with
+// the stamp embedded in its first row, so `spinradar odometry --input` accepts the folder.
+TEST(RealData, BoreasRtFolderUsesEmbeddedStamp) {
+  const std::string dir = kReal + "/boreas_rt";
+  REQUIRE_PATH(dir);
+  const ScanFolder folder(dir, ScanFormat::Boreas);
+  ASSERT_EQ(folder.size(), 1u);
+  const PolarScan s = folder.load(0);
+  EXPECT_EQ(folder.fileStampNs(0), s.stamp_ns.front());
+  EXPECT_EQ(s.bins, 6848);
+}

@@ -35,6 +35,7 @@ class ScanFolder {
   bool empty() const { return files_.empty(); }
   const std::string& path(size_t i) const { return files_.at(i).path; }
   /// Time of the scan from its file name (Oxford: first azimuth, Boreas: middle azimuth,
+  /// a Navtech PNG not named by a stamp: its first row's embedded stamp,
   /// MulRan: last azimuth) or Navtech_Polar.txt (RADIATE), in ns.
   int64_t fileStampNs(size_t i) const { return files_.at(i).stamp_ns; }
   /// Loads scan i with the folder's format and options. Throws std::runtime_error naming the
