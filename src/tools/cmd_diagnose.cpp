@@ -7,6 +7,9 @@
 #include "command.hpp"
 #include "spinradar/core/scan_folder.hpp"
 #include "spinradar/diagnose/diagnose.hpp"
+#ifdef SPINRADAR_HAVE_BAG
+#include "scan_bag.hpp"
+#endif
 
 namespace {
 
@@ -22,9 +25,27 @@ struct DiagnoseArgs {
   bool no_resimulate = false;
 };
 
-sim::SensorConfig sensorFor(const DiagnoseArgs& a, const std::vector<PolarScan>& scans) {
+/// The recording as a scan folder: a rosbag of RadarScan messages is first unpacked into
+/// <out>/recording_from_bag (Oxford layout).
+std::string recordingFolder(const DiagnoseArgs& a) {
+  if (!(fs::is_regular_file(a.recording) && fs::path(a.recording).extension() == ".bag"))
+    return a.recording;
+#ifdef SPINRADAR_HAVE_BAG
+  const std::string dir = (fs::path(a.out) / "recording_from_bag").string();
+  fs::remove_all(dir);
+  const size_t n = bag::bagToFolder(a.recording, dir);
+  std::cout << "read " << n << " scans from " << a.recording << "\n";
+  return dir;
+#else
+  throw std::runtime_error(a.recording + ": reading a rosbag needs spinradar built with ROS "
+                           "(catkin); or unpack it elsewhere with `spinradar bag`");
+#endif
+}
+
+sim::SensorConfig sensorFor(const DiagnoseArgs& a, const std::string& dir,
+                            const std::vector<PolarScan>& scans) {
   sim::SensorConfig s;
-  const fs::path sj = fs::path(a.recording) / "sensor.json";
+  const fs::path sj = fs::path(dir) / "sensor.json";
   if (fs::exists(sj)) {
     s = sim::SensorConfig::load(sj.string());
   } else {
@@ -44,7 +65,8 @@ sim::SensorConfig sensorFor(const DiagnoseArgs& a, const std::vector<PolarScan>&
 void run(const DiagnoseArgs& a) {
   ScanFolderOptions fo;
   if (a.range_resolution > 0) fo.range_resolution = a.range_resolution;
-  ScanFolder folder(a.recording, ScanFormat::Oxford, fo);
+  const std::string dir = recordingFolder(a);
+  ScanFolder folder(dir, ScanFormat::Oxford, fo);
   if (folder.empty()) throw std::runtime_error(a.recording + ": no radar scans found");
   diagnose::DiagnoseInput in;
   const size_t end = a.max_scans < 0 ? folder.size()
@@ -53,7 +75,7 @@ void run(const DiagnoseArgs& a) {
   if (in.scans.empty()) throw std::runtime_error(a.recording + ": no scans in the chosen range");
   if (!a.world.empty()) in.world = sim::World::load(a.world);
   in.trajectory = sim::Trajectory::loadCsv(a.trajectory);
-  in.sensor = sensorFor(a, in.scans);
+  in.sensor = sensorFor(a, dir, in.scans);
   if (!a.base.empty()) in.base = sim::PhysicsConfig::load(a.base);
   for (auto& s : in.scans) s.range_resolution = in.sensor.range_resolution;
 
@@ -80,7 +102,7 @@ SPINRADAR_COMMAND(
     "Compare a recording with its re-simulation: locate, name and fit the physics left out",
     [](CLI::App& app) {
       auto a = std::make_shared<DiagnoseArgs>();
-      app.add_option("--recording", a->recording, "Oxford polar PNG folder (radar/<stamp>.png)")
+      app.add_option("--recording", a->recording, "Oxford polar PNG folder (radar/<stamp>.png) or a rosbag (.bag) of spinradar/RadarScan")
           ->required();
       app.add_option("--trajectory", a->trajectory, "Sensor trajectory CSV t,x,y,yaw")
           ->required();
