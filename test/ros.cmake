@@ -9,6 +9,16 @@ if(SPINRADAR_ROS)
   add_dependencies(ros_test_glue ${PROJECT_NAME}_generate_messages_cpp ${PROJECT_NAME}_gencfg)
   gtest_discover_tests(ros_test_glue DISCOVERY_MODE PRE_TEST TEST_PREFIX "ros." PROPERTIES TIMEOUT 60)
 
+  # The localizer nodelet's map -> odom path on the simulator (no master).
+  if(TARGET spinradar_sim)
+    add_executable(ros_test_map_localization test/ros/test_map_localization.cpp)
+    target_include_directories(ros_test_map_localization PRIVATE ${PROJECT_SOURCE_DIR}/include)
+    target_link_libraries(ros_test_map_localization PRIVATE spinradar_sim spinradar_core
+      ${SPINRADAR_GTEST} Threads::Threads)
+    gtest_discover_tests(ros_test_map_localization DISCOVERY_MODE PRE_TEST TEST_PREFIX "ros."
+      PROPERTIES TIMEOUT 60)
+  endif()
+
   add_test(NAME ros.config_yaml_matches_params
     COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/test/ros/check_config_yaml.py)
 endif()
