@@ -60,11 +60,15 @@ endif()
 if(TARGET spinradar_nodelets AND CATKIN_ENABLE_TESTING)
   find_package(rostest QUIET)
   if(rostest_FOUND)
-    add_rostest_gtest(ros_test_driver_nodelet test/ros/driver.test test/ros/test_driver_nodelet.cpp)
-    target_include_directories(ros_test_driver_nodelet PRIVATE
+    # A plain executable (add_rostest_gtest would leave it out of `all`, so a fresh
+    # build-then-ctest would run a rostest whose node was never built).
+    add_executable(ros_test_driver_nodelet test/ros/test_driver_nodelet.cpp)
+    target_include_directories(ros_test_driver_nodelet PRIVATE ${PROJECT_SOURCE_DIR}/include
       ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION} ${catkin_INCLUDE_DIRS})
-    target_link_libraries(ros_test_driver_nodelet ${catkin_LIBRARIES})
-    add_dependencies(ros_test_driver_nodelet ${PROJECT_NAME}_generate_messages_cpp spinradar_nodelets
+    target_link_libraries(ros_test_driver_nodelet PRIVATE ${catkin_LIBRARIES} ${SPINRADAR_GTEST}
+      Threads::Threads)
+    add_dependencies(ros_test_driver_nodelet ${PROJECT_NAME}_generate_messages_cpp)
+    add_rostest(test/ros/driver.test DEPENDENCIES ros_test_driver_nodelet spinradar_nodelets
       spinradar_cli)
   endif()
 endif()
