@@ -9,11 +9,14 @@
 #include "command.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
+#ifdef SPINRADAR_HAVE_BAG
+#include "scan_bag.hpp"
+#endif
 
 namespace {
 
 struct SimulateOptions {
-  std::string scene, world, trajectory, physics, sensor, out;
+  std::string scene, world, trajectory, physics, sensor, out, bag;
   uint64_t seed = 1;
   uint64_t variant = 0;
   int scans = -1;
@@ -59,6 +62,19 @@ void runSimulate(const SimulateOptions& o) {
   double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cerr << "simulate: wrote " << n << " scans to " << o.out << " in " << secs << " s ("
             << (secs > 0 ? n / secs : 0.0) << " scans/s including PNG encoding)\n";
+  if (!o.bag.empty()) {
+#ifdef SPINRADAR_HAVE_BAG
+    spinradar::bag::ScanBagOptions bo;
+    bo.rotation_hz = sensor.rotation_hz;
+    spinradar::ScanFolderOptions fo;
+    fo.range_resolution = sensor.range_resolution;
+    const size_t m = spinradar::bag::folderToBag(
+        spinradar::ScanFolder(o.out, spinradar::ScanFormat::Oxford, fo), o.bag, bo);
+    std::cerr << "simulate: wrote " << m << " RadarScan messages to " << o.bag << "\n";
+#else
+    throw std::runtime_error("--bag needs spinradar built with ROS (catkin)");
+#endif
+  }
 }
 
 }  // namespace
@@ -81,6 +97,8 @@ SPINRADAR_COMMAND("simulate", "Simulate a recording (Oxford polar PNGs + true tr
                     app.add_option("--scans", o->scans, "Number of scans (default: all)");
                     app.add_option("--first", o->first, "First scan index")->capture_default_str();
                     app.add_option("--out", o->out, "Output recording folder");
+                    app.add_option("--bag", o->bag,
+                                   "Also write the scans as a rosbag of spinradar/RadarScan");
                     app.add_flag("--list-scenes", o->list, "List the built-in scenes and exit");
                     app.callback([o] { runSimulate(*o); });
                   });

@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # `spinradar diagnose` reads a rosbag of RadarScan messages: a simulated drive with a hidden
-# Doppler shift (beta 0.049 s), written to a bag, must be diagnosed as `doppler` within 10 %.
+# Doppler shift (beta 0.049 s), written to a bag by `spinradar simulate --bag`, must be diagnosed as `doppler` within 10 %.
 # Usage: diagnose_bag.sh SPINRADAR_BIN OUT_DIR
 set -euo pipefail
 bin="$1"; out="$2"
 rm -rf "$out"; mkdir -p "$out"
 echo '{"doppler": 0.049}' > "$out/hidden.json"
-"$bin" simulate --scene tight_turns --physics "$out/hidden.json" --scans 8 --seed 5 --out "$out/rec" > /dev/null
-"$bin" bag --input "$out/rec" --out "$out/rec.bag" > /dev/null
+"$bin" simulate --scene tight_turns --physics "$out/hidden.json" --scans 8 --seed 5 --out "$out/rec" \
+  --bag "$out/rec.bag" > /dev/null
 "$bin" diagnose --recording "$out/rec.bag" --trajectory "$out/rec/trajectory.csv" \
   --world "$out/rec/world.json" --out "$out/diag"
 /usr/bin/python3 - "$out/diag/report.json" <<'PY'
