@@ -1,5 +1,6 @@
 #pragma once
 // Helpers for file-format errors that name the file, the line and the reason.
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -34,5 +35,27 @@ nlohmann::json parseJson(const std::string& text, const std::string& name);
 
 /// Error with location: "<name>:<line>: <reason>" (or "<name>: <reason>" when line is 0).
 [[noreturn]] void fail(const std::string& name, int line, const std::string& reason);
+
+/// T::fromJson over a JSON file; a JsonPathError becomes "<path>:<line>: <where>: <reason>".
+template <class T>
+T loadJsonFile(const std::string& path) {
+  const std::string text = readFile(path);
+  const nlohmann::json j = parseJson(text, path);
+  try {
+    return T::fromJson(j);
+  } catch (const JsonPathError& e) {
+    const std::string where = pathString(e.path);
+    fail(path, jsonLineOf(text, e.path), where.empty() ? e.reason : where + ": " + e.reason);
+  }
+}
+
+/// Writes v.toJson() to path, one space indented.
+template <class T>
+void saveJsonFile(const T& v, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write");
+  out << v.toJson().dump(1) << "\n";
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
 
 }  // namespace spinradar::sim::detail

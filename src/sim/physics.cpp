@@ -111,23 +111,10 @@ nlohmann::json PhysicsConfig::toJson() const {
 }
 
 PhysicsConfig PhysicsConfig::load(const std::string& path) {
-  std::string text = detail::readFile(path);
-  nlohmann::json j = detail::parseJson(text, path);
-  try {
-    return fromJson(j);
-  } catch (const JsonPathError& e) {
-    std::string where = detail::pathString(e.path);
-    detail::fail(path, detail::jsonLineOf(text, e.path),
-                 where.empty() ? e.reason : where + ": " + e.reason);
-  }
+  return detail::loadJsonFile<PhysicsConfig>(path);
 }
 
-void PhysicsConfig::save(const std::string& path) const {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot write");
-  out << toJson().dump(1) << "\n";
-  if (!out) throw std::runtime_error(path + ": write failed");
-}
+void PhysicsConfig::save(const std::string& path) const { detail::saveJsonFile(*this, path); }
 
 std::vector<std::string> PhysicsConfig::activeEffects() const {
   std::vector<std::string> out;

@@ -108,23 +108,10 @@ nlohmann::json World::toJson() const {
 }
 
 World World::load(const std::string& path) {
-  std::string text = detail::readFile(path);
-  nlohmann::json j = detail::parseJson(text, path);
-  try {
-    return fromJson(j);
-  } catch (const JsonPathError& e) {
-    std::string where = detail::pathString(e.path);
-    detail::fail(path, detail::jsonLineOf(text, e.path),
-                 where.empty() ? e.reason : where + ": " + e.reason);
-  }
+  return detail::loadJsonFile<World>(path);
 }
 
-void World::save(const std::string& path) const {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot write");
-  out << toJson().dump(1) << "\n";
-  if (!out) throw std::runtime_error(path + ": write failed");
-}
+void World::save(const std::string& path) const { detail::saveJsonFile(*this, path); }
 
 // ---------------------------------------------------------------------------------------------
 

@@ -59,22 +59,9 @@ SensorConfig SensorConfig::fromJson(const nlohmann::json& j) {
 }
 
 SensorConfig SensorConfig::load(const std::string& path) {
-  std::string text = detail::readFile(path);
-  nlohmann::json j = detail::parseJson(text, path);
-  try {
-    return fromJson(j);
-  } catch (const detail::JsonPathError& e) {
-    std::string where = detail::pathString(e.path);
-    detail::fail(path, detail::jsonLineOf(text, e.path),
-                 where.empty() ? e.reason : where + ": " + e.reason);
-  }
+  return detail::loadJsonFile<SensorConfig>(path);
 }
 
-void SensorConfig::save(const std::string& path) const {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot write");
-  out << toJson().dump(1) << "\n";
-  if (!out) throw std::runtime_error(path + ": write failed");
-}
+void SensorConfig::save(const std::string& path) const { detail::saveJsonFile(*this, path); }
 
 }  // namespace spinradar::sim
