@@ -16,12 +16,8 @@ seed="${SEED:-1}"
 min_speed="${MIN_SPEED:-10}"
 prior="${PRIOR:-truth}"
 
-bin="${SPINRADAR_BIN:-}"
-if [[ -z "$bin" ]]; then
-  for b in "$root/build/devel/lib/spinradar/spinradar" "$root/build/bin/spinradar"; do
-    [[ -x "$b" ]] && { bin="$b"; break; }
-  done
-fi
+source "$root/scripts/cli_path.sh"
+bin="$(spinradar_cli_path "$root")"
 [[ -x "$bin" ]] || { echo "error: spinradar CLI not found (build it, or set SPINRADAR_BIN)" >&2; exit 1; }
 for sub in simulate localize; do
   "$bin" "$sub" --help > /dev/null 2>&1 || { echo "error: '$bin' has no '$sub' subcommand" >&2; exit 1; }

@@ -17,18 +17,12 @@ seed="${SEED:-1}"
 threads="${THREADS:-2}"
 step="${STEP:-4}"
 
-bin="${SPINRADAR_BIN:-}"
-if [[ -z "$bin" ]]; then
-  for b in "$root/build/devel/lib/spinradar/spinradar" "$root/build/bin/spinradar"; do
-    [[ -x "$b" ]] && { bin="$b"; break; }
-  done
-fi
+source "$root/scripts/cli_path.sh"
+bin="$(spinradar_cli_path "$root")"
 if [[ -z "$bin" ]]; then
   echo "== building spinradar (scripts/build.sh)" >&2
   bash "$root/scripts/build.sh"
-  for b in "$root/build/devel/lib/spinradar/spinradar" "$root/build/bin/spinradar"; do
-    [[ -x "$b" ]] && { bin="$b"; break; }
-  done
+  bin="$(spinradar_cli_path "$root")"
 fi
 [[ -x "$bin" ]] || { echo "error: spinradar CLI not found" >&2; exit 1; }
 for sub in simulate odometry eval; do

@@ -18,9 +18,8 @@ while [[ $# -gt 0 ]]; do
   shift
 done
 if [[ -z "$bin" ]]; then
-  for b in "$root/build/devel/lib/spinradar/spinradar" "$root/build/bin/spinradar"; do
-    [[ -x "$b" ]] && { bin="$b"; break; }
-  done
+  source "$root/scripts/cli_path.sh"
+  bin="$(spinradar_cli_path "$root")"
 fi
 [[ -n "$bin" && -x "$bin" ]] || { echo "error: spinradar binary not found (build first or pass --bin)" >&2; exit 2; }
 [[ -f "$readme" ]] || { echo "error: $readme: no such file" >&2; exit 2; }
