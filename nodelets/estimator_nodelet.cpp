@@ -5,7 +5,6 @@
 #include <memory>
 #include <mutex>
 
-#include <dynamic_reconfigure/server.h>
 #include <nav_msgs/Path.h>
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
@@ -17,6 +16,7 @@
 #include "spinradar/core/odometry.hpp"
 #include "spinradar_ros/conversions.hpp"
 #include "spinradar_ros/params.hpp"
+#include "spinradar_ros/validated_reconfigure.hpp"
 
 namespace spinradar_ros {
 
@@ -41,19 +41,8 @@ class EstimatorNodelet : public nodelet::Nodelet {
     corrected_pub_ = nh.advertise<sensor_msgs::PointCloud2>("points_corrected", 10);
     raw_pub_ = nh.advertise<sensor_msgs::PointCloud2>("points_raw", 10);
     path_pub_ = nh.advertise<nav_msgs::Path>("path", 1);
-    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<spinradar::EstimatorNodeletConfig>>(
-        reconfigure_mutex_, pnh);
-    reconfigure_->setCallback([this](spinradar::EstimatorNodeletConfig& c, uint32_t) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      const std::string error = applyReconfigure(c, config_);
-      if (!error.empty()) {
-        NODELET_ERROR("rejected reconfiguration: %s", error.c_str());
-        c = accepted_;  // reports the parameters actually in use back to the client
-        return;
-      }
-      accepted_ = c;
-      odometry_->setConfig(config_);
-    });
+    reconfigure_ = std::make_unique<Reconfigure>(
+        pnh, config_, mutex_, [this] { odometry_->setConfig(config_); });
     sub_ = nh.subscribe("features", pnh.param("queue_size", 20), &EstimatorNodelet::onFeatures,
                         this);
     NODELET_INFO("estimator '%s', publishing %s -> %s", config_.estimator.estimator.c_str(),
@@ -143,9 +132,8 @@ class EstimatorNodelet : public nodelet::Nodelet {
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   ros::Subscriber sub_;
   ros::Publisher odom_pub_, velocity_pub_, corrected_pub_, raw_pub_, path_pub_;
-  boost::recursive_mutex reconfigure_mutex_;
-  std::unique_ptr<dynamic_reconfigure::Server<spinradar::EstimatorNodeletConfig>> reconfigure_;
-  spinradar::EstimatorNodeletConfig accepted_ = spinradar::EstimatorNodeletConfig::__getDefault__();
+  using Reconfigure = ValidatedReconfigure<spinradar::EstimatorNodeletConfig, spinradar::PipelineConfig>;
+  std::unique_ptr<Reconfigure> reconfigure_;
 };
 
 }  // namespace spinradar_ros

@@ -5,7 +5,6 @@
 #include <memory>
 #include <mutex>
 
-#include <dynamic_reconfigure/server.h>
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 
@@ -14,6 +13,7 @@
 #include "spinradar/core/feature_extractor.hpp"
 #include "spinradar_ros/conversions.hpp"
 #include "spinradar_ros/params.hpp"
+#include "spinradar_ros/validated_reconfigure.hpp"
 #include "spinradar_ros/polar_scan_conversions.hpp"
 
 namespace spinradar_ros {
@@ -33,17 +33,7 @@ class FeatureNodelet : public nodelet::Nodelet {
 
     features_pub_ = nh.advertise<spinradar::Features>("features", 20);
     debug_pub_ = nh.advertise<sensor_msgs::Image>("debug_image", 1);
-    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<spinradar::FeatureNodeletConfig>>(
-        reconfigure_mutex_, pnh);
-    reconfigure_->setCallback([this](spinradar::FeatureNodeletConfig& c, uint32_t) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      const std::string error = applyReconfigure(c, config_);
-      if (!error.empty()) {
-        NODELET_ERROR("rejected reconfiguration: %s", error.c_str());
-        c = accepted_;  // reports the parameters actually in use back to the client
-        return;
-      }
-      accepted_ = c;
+    reconfigure_ = std::make_unique<Reconfigure>(pnh, config_, mutex_, [this] {
       extractor_ = std::make_unique<spinradar::FeatureExtractor>(config_.detector, config_.features);
     });
 
@@ -107,9 +97,8 @@ class FeatureNodelet : public nodelet::Nodelet {
 
   ros::Subscriber sub_;
   ros::Publisher features_pub_, debug_pub_;
-  boost::recursive_mutex reconfigure_mutex_;
-  std::unique_ptr<dynamic_reconfigure::Server<spinradar::FeatureNodeletConfig>> reconfigure_;
-  spinradar::FeatureNodeletConfig accepted_ = spinradar::FeatureNodeletConfig::__getDefault__();
+  using Reconfigure = ValidatedReconfigure<spinradar::FeatureNodeletConfig, spinradar::PipelineConfig>;
+  std::unique_ptr<Reconfigure> reconfigure_;
 };
 
 }  // namespace spinradar_ros
