@@ -2,6 +2,8 @@
 // effects, joint fit, confounding and identifiability notes.
 #include <algorithm>
 #include <map>
+
+#include <Eigen/Dense>
 #include <sstream>
 #include <string>
 
@@ -17,6 +19,84 @@ struct Design {
   Eigen::MatrixXd N, C, A;  // nuisance (none by default), candidates, per-scan rigid alignment
   std::vector<int> rows;    // observation of each stacked row
 };
+
+// Without a world file (map != nullptr): the test views of one target share its map error,
+// so the rows of each target are whitened jointly (generalised least squares) with the
+// covariance diag(white^2) + J cov J^T, J = d(range, azimuth)/d(target position).
+void whitenByTarget(Design& d, const std::vector<Observation>& obs, const MapModel& map,
+                    double sr, double sa, double wr, double wa) {
+  const int m = static_cast<int>(d.rows.size());
+  std::map<int, std::vector<int>> of_target;
+  for (int j = 0; j < m; ++j) of_target[obs[d.rows[j]].target].push_back(j);
+  for (const auto& [t, js] : of_target) {
+    const int n = static_cast<int>(js.size());
+    std::vector<int> rows;
+    for (int j : js) rows.push_back(j);
+    for (int j : js) rows.push_back(m + j);
+    Eigen::MatrixXd K(2 * n, 2);
+    Eigen::VectorXd white(2 * n);
+    for (int q = 0; q < n; ++q) {
+      const Observation& o = obs[d.rows[js[q]]];
+      K.row(q) << o.tr[0] / sr, o.tr[1] / sr;
+      K.row(n + q) << o.taz[0] / sa, o.taz[1] / sa;
+      white(q) = wr * wr / (sr * sr);
+      white(n + q) = wa * wa / (sa * sa);
+    }
+    Eigen::MatrixXd cov = K * map.cov[t] * K.transpose();
+    cov.diagonal() += white;
+    const Eigen::LLT<Eigen::MatrixXd> llt(cov);
+    if (llt.info() != Eigen::Success) continue;
+    auto apply = [&](Eigen::MatrixXd& M) {
+      if (M.cols() == 0) return;
+      Eigen::MatrixXd B(2 * n, M.cols());
+      for (int q = 0; q < 2 * n; ++q) B.row(q) = M.row(rows[q]);
+      B = llt.matrixL().solve(B);
+      for (int q = 0; q < 2 * n; ++q) M.row(rows[q]) = B.row(q);
+    };
+    Eigen::MatrixXd Y = d.y;
+    apply(Y);
+    d.y = Y.col(0);
+    apply(d.N);
+    apply(d.C);
+    apply(d.A);
+  }
+}
+
+// White (per-view) part of the residual noise when the map error is common per target: the
+// scatter left after fitting each target's position shift to its residuals.
+std::pair<double, double> withinTargetScales(const std::vector<Observation>& obs,
+                                             const std::vector<double>& er,
+                                             const std::vector<double>& ea, double sr, double sa,
+                                             double floor_r, double floor_a) {
+  std::map<int, std::vector<int>> of_target;
+  for (size_t i = 0; i < obs.size(); ++i)
+    if (obs[i].inlier) of_target[obs[i].target].push_back(static_cast<int>(i));
+  std::vector<double> rr, ra;
+  int rows = 0, params = 0;
+  for (const auto& [t, is] : of_target) {
+    const int n = static_cast<int>(is.size());
+    if (n < 2) continue;
+    Eigen::MatrixXd K(2 * n, 2);
+    Eigen::VectorXd y(2 * n);
+    for (int q = 0; q < n; ++q) {
+      const Observation& o = obs[is[q]];
+      K.row(q) << o.tr[0] / sr, o.tr[1] / sr;
+      K.row(n + q) << o.taz[0] / sa, o.taz[1] / sa;
+      y(q) = er[is[q]] / sr;
+      y(n + q) = ea[is[q]] / sa;
+    }
+    const Eigen::VectorXd res = y - K * K.colPivHouseholderQr().solve(y);
+    for (int q = 0; q < n; ++q) {
+      rr.push_back(res(q) * sr);
+      ra.push_back(res(n + q) * sa);
+    }
+    rows += 2 * n;
+    params += 2;
+  }
+  if (rows <= params) return {sr, sa};
+  const double dof = std::sqrt(static_cast<double>(rows) / (rows - params));
+  return {noiseScale(rr, floor_r) * dof, noiseScale(ra, floor_a) * dof};
+}
 
 Design buildDesign(const std::vector<Observation>& obs, const std::vector<Effect>& cands,
                    double sr, double sa, int n_scans, bool target_nuisance) {
@@ -81,7 +161,8 @@ double noiseScale(const std::vector<double>& v, double floor) {
 }
 
 void nameAndFitEffects(const DiagnoseInput& in, const DiagnoseOptions& opt,
-                       const std::vector<Effect>& cands, DiagnoseReport& rep) {
+                       const std::vector<Effect>& cands, DiagnoseReport& rep,
+                       const MapModel* map) {
   // 2. Two passes: robust scales and outliers from the base residuals, then from the fit.
   std::vector<double> er, eaz;
   for (const auto& o : rep.obs) {
@@ -106,6 +187,15 @@ void nameAndFitEffects(const DiagnoseInput& in, const DiagnoseOptions& opt,
   Design d;
   for (int pass = 0; pass < 2; ++pass) {
     d = buildDesign(rep.obs, cands, sr, sa, rep.scans, opt.target_nuisance);
+    if (map) {
+      std::vector<double> cr, ca;
+      for (const auto& o : rep.obs) {
+        cr.push_back(pass == 0 ? o.e_r : o.fit_r);
+        ca.push_back(pass == 0 ? o.e_az : o.fit_az);
+      }
+      const auto [wr, wa] = withinTargetScales(rep.obs, cr, ca, sr, sa, floor_r, floor_a);
+      whitenByTarget(d, rep.obs, *map, sr, sa, wr, wa);
+    }
     sel = stepwiseSelect(d.y, d.N, d.C, so);
     // Residuals of every observation under the joint fit.
     std::vector<double> rr, ra;
@@ -120,7 +210,7 @@ void nameAndFitEffects(const DiagnoseInput& in, const DiagnoseOptions& opt,
       o.fit_az = fa;
     }
     // Inliers: the joint fit's residuals (they include the nuisance part).
-    {
+    if (!map) {
       const int m = static_cast<int>(d.rows.size());
       for (int j = 0; j < m; ++j) {
         rep.obs[d.rows[j]].fit_r = sel.joint.resid(j) * sr;

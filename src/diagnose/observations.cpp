@@ -9,7 +9,8 @@
 namespace spinradar::diagnose::detail {
 
 Association associateObservations(const DiagnoseInput& in, const DiagnoseOptions& opt,
-                                  const std::vector<Effect>& cands, DiagnoseReport& rep) {
+                                  const std::vector<Effect>& cands, DiagnoseReport& rep,
+                                  const MapModel* map) {
   Association as;
   std::vector<ScanGeometry>& geos = as.geos;
   std::vector<std::vector<int>>& obs_of_scan = as.obs_of_scan;
@@ -45,14 +46,27 @@ Association associateObservations(const DiagnoseInput& in, const DiagnoseOptions
       o.real_r = pk->range;
       o.real_az = pk->azimuth;
       const sim::Target& tg = in.world.targets[v.target];
+      const double hp = 0.01, ha = 0.001;
+      for (int q = 0; q < 2; ++q) {
+        sim::Target moved = tg;
+        (q == 0 ? moved.x : moved.y) += hp;
+        const Prediction pq = predictTarget(moved, geo, in.trajectory, in.base, opt.conventions);
+        o.tr[q] = (pq.range - v.pred.range) / hp;
+        o.taz[q] = wrapPi(pq.azimuth - v.pred.azimuth) / hp;
+      }
       for (Effect e : cands) {
         const double h = effectStep(e);
         const Prediction pe = predictTarget(tg, geo, in.trajectory, withEffect(in.base, e, h),
                                             opt.conventions);
         o.dr[static_cast<int>(e)] = (pe.range - v.pred.range) / h;
         o.daz[static_cast<int>(e)] = wrapPi(pe.azimuth - v.pred.azimuth) / h;
+        if (map) {
+          // The mapped position moves with the parameter too (it was placed under it).
+          const Eigen::Vector2d& dp = map->dpos[v.target][static_cast<int>(e)];
+          o.dr[static_cast<int>(e)] += o.tr[0] * dp.x() + o.tr[1] * dp.y();
+          o.daz[static_cast<int>(e)] += o.taz[0] * dp.x() + o.taz[1] * dp.y();
+        }
       }
-      const double hp = 0.01, ha = 0.001;
       const PoseDelta deltas[3] = {{hp, 0, 0}, {0, hp, 0}, {0, 0, ha}};
       const double steps[3] = {hp, hp, ha};
       for (int q = 0; q < 3; ++q) {
@@ -60,13 +74,6 @@ Association associateObservations(const DiagnoseInput& in, const DiagnoseOptions
             predictTarget(tg, geo, in.trajectory, in.base, opt.conventions, deltas[q]);
         o.nr[q] = (pq.range - v.pred.range) / steps[q];
         o.naz[q] = wrapPi(pq.azimuth - v.pred.azimuth) / steps[q];
-      }
-      for (int q = 0; q < 2; ++q) {
-        sim::Target moved = tg;
-        (q == 0 ? moved.x : moved.y) += hp;
-        const Prediction pq = predictTarget(moved, geo, in.trajectory, in.base, opt.conventions);
-        o.tr[q] = (pq.range - v.pred.range) / hp;
-        o.taz[q] = wrapPi(pq.azimuth - v.pred.azimuth) / hp;
       }
       cand_obs.push_back(o);
       gates.push_back(v.gate);

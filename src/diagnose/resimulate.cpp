@@ -35,7 +35,8 @@ std::vector<Measured> measureSimulated(const sim::Simulator& sim, const PolarSca
                                        const ScanGeometry& geo_real,
                                        const std::vector<const Observation*>& views,
                                        const std::vector<Gate>& gates, const DiagnoseInput& in,
-                                       const DiagnoseOptions& opt) {
+                                       const DiagnoseOptions& opt, const sim::World* world) {
+  const sim::World& w = world ? *world : in.world;
   const sim::PhysicsConfig& ph = sim.physics();
   const double t0 = geo_real.firstStamp() - ph.timestamp_offset;
   PolarScan s = sim.renderScanAt(t0);
@@ -44,7 +45,7 @@ std::vector<Measured> measureSimulated(const sim::Simulator& sim, const PolarSca
   const ScanGeometry geo = ScanGeometry::fromScan(s);
   std::vector<Measured> out(views.size());
   for (size_t i = 0; i < views.size(); ++i) {
-    const Prediction p = predictTarget(in.world.targets[views[i]->target], geo, in.trajectory, ph,
+    const Prediction p = predictTarget(w.targets[views[i]->target], geo, in.trajectory, ph,
                                        opt.conventions);
     if (!p.ok) continue;
     const auto pk = measurePeak(s, geo, p.range, p.azimuth, gates[i], opt.peaks);
@@ -79,7 +80,7 @@ ResidualStats residualStats(bool demean, const std::vector<Observation>& obs,
 }
 
 void resimulateWithEffects(const DiagnoseInput& in, const DiagnoseOptions& opt,
-                           const Association& as, DiagnoseReport& rep) {
+                           const Association& as, DiagnoseReport& rep, const MapModel* map) {
   const std::vector<ScanGeometry>& geos = as.geos;
   const std::vector<std::vector<int>>& obs_of_scan = as.obs_of_scan;
   const std::vector<Gate>& gate_of_obs = as.gate_of_obs;
@@ -120,7 +121,9 @@ void resimulateWithEffects(const DiagnoseInput& in, const DiagnoseOptions& opt,
     };
     auto trial = [&](const sim::PhysicsConfig& ph) {
       Trial t;
-      sim::Simulator s(in.world, in.trajectory, in.sensor, ph, opt.seed);
+      // Without a world file the map is re-placed under the trial physics first.
+      const sim::World world = map && map->remap ? map->remap(ph) : in.world;
+      sim::Simulator s(world, in.trajectory, in.sensor, ph, opt.seed);
       t.er_j.assign(rep.obs.size(), NAN);
       t.ea_j.assign(rep.obs.size(), NAN);
       for (size_t k = 0; k < in.scans.size(); ++k) {
@@ -131,7 +134,7 @@ void resimulateWithEffects(const DiagnoseInput& in, const DiagnoseOptions& opt,
           gates.push_back(gate_of_obs[i]);
         }
         if (ptrs.empty()) continue;
-        const auto m = measureSimulated(s, in.scans[k], geos[k], ptrs, gates, in, opt);
+        const auto m = measureSimulated(s, in.scans[k], geos[k], ptrs, gates, in, opt, &world);
         for (size_t q = 0; q < ptrs.size(); ++q) {
           if (!m[q].ok) continue;
           const int i = obs_of_scan[k][q];

@@ -13,6 +13,7 @@ namespace {
 struct Cluster {
   double sx = 0, sy = 0, sdb = 0;
   int n = 0, last_scan = -1, scans = 0;
+  std::vector<MapPeak> peaks;
   double x() const { return sx / n; }
   double y() const { return sy / n; }
 };
@@ -26,6 +27,41 @@ double parabola(double m, double c, double p) {
 
 }  // namespace
 
+Eigen::Vector2d placePeak(const MapPeak& pk, const sim::Trajectory& traj,
+                          const sim::PhysicsConfig& ph) {
+  // Mirrors predictTarget: pose per azimuth with motion distortion, otherwise at the scan's
+  // instant (mid-sweep, or the first azimuth with the "scan_pose_time": "start" extra).
+  const auto it = ph.extra.find("scan_pose_time");
+  const bool at_start = it != ph.extra.end() && it->is_string() && *it == "start";
+  const double t_row = pk.stamp - ph.timestamp_offset;
+  const double t_pose = ph.motion_distortion
+                            ? t_row
+                            : pk.first_stamp - ph.timestamp_offset + (at_start ? 0.0 : 0.5) * pk.sweep;
+  const sim::Pose2 p = traj.at(t_pose);
+  const double phi = pk.azimuth - ph.azimuth_offset;
+  double range = pk.range - ph.range_offset;
+  if (ph.doppler != 0) {
+    const Eigen::Vector3d vb = traj.bodyVelocity(t_pose);
+    range += ph.doppler * (vb.x() * std::cos(phi) - vb.y() * std::sin(phi));
+  }
+  const double xs = range * std::cos(phi), ys = -range * std::sin(phi);
+  return {p.x + std::cos(p.yaw) * xs - std::sin(p.yaw) * ys,
+          p.y + std::sin(p.yaw) * xs + std::cos(p.yaw) * ys};
+}
+
+sim::World replaceMap(const SceneMap& map, const sim::Trajectory& traj,
+                      const sim::PhysicsConfig& physics) {
+  sim::World w = map.world;
+  for (size_t j = 0; j < w.targets.size(); ++j) {
+    Eigen::Vector2d s = Eigen::Vector2d::Zero();
+    for (const MapPeak& pk : map.members[j]) s += placePeak(pk, traj, physics);
+    s /= static_cast<double>(map.members[j].size());
+    w.targets[j].x = s.x();
+    w.targets[j].y = s.y();
+  }
+  return w;
+}
+
 SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajectory& traj,
                        const sim::SensorConfig& sensor, const sim::PhysicsConfig& base,
                        const std::string& split, const SceneMapOptions& opt) {
@@ -33,20 +69,29 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
   const int n = static_cast<int>(scans.size());
   if (n < 4) throw std::runtime_error("scene map: need at least 4 scans (2 to map, 2 to test)");
   int cut = n / 2;
-  m.split = split;
-  bool map_first = split != "late-early";
-  if (split == "out-back") {
+  const bool map_first = split != "late-early";
+  if (split == "out-back" || split == "auto") {
+    // The return leg starts where the heading has turned by 90 degrees from the start (the
+    // middle of the U-turn); both legs need at least 2 scans.
     const double yaw0 = traj.at(scans.front().firstStamp() * 1e-9).yaw;
-    cut = -1;
-    for (int k = 0; k < n && cut < 0; ++k)
+    int rev = -1;
+    for (int k = 0; k < n && rev < 0; ++k)
       if (std::fabs(std::remainder(traj.at(scans[k].firstStamp() * 1e-9).yaw - yaw0,
-                                   2 * M_PI)) > 2.6)
-        cut = k;
-    if (cut < 2 || cut > n - 2) {
-      cut = n / 2;
-      m.split = "early-late (no heading reversal found for out-back)";
+                                   2 * M_PI)) > 0.5 * M_PI)
+        rev = k;
+    bool reversal = false;
+    if (rev >= 2 && rev <= n - 2)
+      for (int k = rev; k < n && !reversal; ++k)
+        reversal = std::fabs(std::remainder(traj.at(scans[k].firstStamp() * 1e-9).yaw - yaw0,
+                                            2 * M_PI)) > 2.6;
+    const std::string how = split == "auto" ? "auto: " : "";
+    if (reversal) {
+      cut = rev;
+      m.split = how + "out-back (scans before the heading has turned by 90 deg map, the return "
+                      "leg is diagnosed)";
     } else {
-      m.split = "out-back (outbound leg maps, return leg is diagnosed)";
+      m.split = how + "early-late (" + (split == "auto" ? "no" : "out-back asked, but no") +
+                " heading reversal in the drive; first half maps, second half is diagnosed)";
     }
   } else if (split == "early-late") {
     m.split = "early-late (first half maps, second half is diagnosed)";
@@ -54,7 +99,7 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
     m.split = "late-early (second half maps, first half is diagnosed)";
   } else {
     throw std::invalid_argument("scene map: unknown split '" + split +
-                                "' (early-late, late-early, out-back)");
+                                "' (auto, early-late, late-early, out-back)");
   }
   for (int k = 0; k < n; ++k) ((k < cut) == map_first ? m.map_scans : m.test_scans).push_back(k);
 
@@ -64,7 +109,6 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
   for (int k : m.map_scans) {
     const PolarScan& s = scans[k];
     const ScanGeometry geo = ScanGeometry::fromScan(s);
-    const double t_mid = geo.firstStamp() - base.timestamp_offset + 0.5 * geo.sweep;
     for (size_t gi = 1; gi + 1 < geo.row.size(); ++gi) {
       const uint8_t* row = s.row(geo.row[gi]);
       const uint8_t* up = s.row(geo.row[gi - 1]);
@@ -80,18 +124,15 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
         const double r = s.rangeOfBin(b + parabola(row[b - 1], v, row[b + 1]));
         if (r < opt.min_range) continue;
         const double az = geo.azimuthAt(gi + parabola(up[b], v, dn[b]));
-        const double t = geo.stamp[gi] - base.timestamp_offset;
-        const sim::Pose2 p = traj.at(base.motion_distortion ? t : t_mid);
-        // Undo the base model's reported-range and azimuth conventions.
-        double range = r - base.range_offset;
-        const double phi = az - base.azimuth_offset;
-        if (base.doppler != 0) {
-          const Eigen::Vector3d vb = traj.bodyVelocity(base.motion_distortion ? t : t_mid);
-          range += base.doppler * (vb.x() * std::cos(phi) - vb.y() * std::sin(phi));
-        }
-        const double xs = range * std::cos(phi), ys = -range * std::sin(phi);
-        const double wx = p.x + std::cos(p.yaw) * xs - std::sin(p.yaw) * ys;
-        const double wy = p.y + std::sin(p.yaw) * xs + std::cos(p.yaw) * ys;
+        MapPeak pk;
+        pk.scan = k;
+        pk.range = r;
+        pk.azimuth = az;
+        pk.stamp = geo.stamp[gi];
+        pk.first_stamp = geo.firstStamp();
+        pk.sweep = geo.sweep;
+        const Eigen::Vector2d wp = placePeak(pk, traj, base);
+        const double wx = wp.x(), wy = wp.y();
         ++m.peaks;
         const int cx = static_cast<int>(std::floor(wx / cell)),
                   cy = static_cast<int>(std::floor(wy / cell));
@@ -115,6 +156,7 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
           grid[cellKey(cx, cy)].push_back(best);
         }
         Cluster& c = clusters[best];
+        c.peaks.push_back(pk);
         c.sx += wx;
         c.sy += wy;
         c.sdb += v / sensor.power_scale - sensor.radar_constant_db +
@@ -135,42 +177,9 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
     t.y = c.y();
     t.rcs = c.sdb / c.n;
     m.world.targets.push_back(t);
+    m.members.push_back(c.peaks);
   }
   return m;
-}
-
-}  // namespace spinradar::diagnose
-
-// ---- diagnosis without a world file ----
-#include "spinradar/diagnose/diagnose.hpp"
-
-namespace spinradar::diagnose {
-
-DiagnoseReport diagnoseWithoutWorld(const DiagnoseInput& in, const DiagnoseOptions& opt,
-                                    const std::string& split) {
-  const SceneMap map = buildSceneMap(in.scans, in.trajectory, in.sensor, in.base, split);
-  if (map.world.targets.empty())
-    throw std::runtime_error("diagnose: no static returns were stable across the map scans");
-  DiagnoseInput test;
-  test.world = map.world;
-  test.trajectory = in.trajectory;
-  test.sensor = in.sensor;
-  test.base = in.base;
-  for (int k : map.test_scans) test.scans.push_back(in.scans[k]);
-  DiagnoseOptions o = opt;
-  o.target_nuisance = true;  // the mapped positions carry the effect's average: refit them
-  DiagnoseReport rep = diagnose(test, o);
-  rep.scene_model = "built from the recording: " + map.split + "; " +
-                    std::to_string(map.map_scans.size()) + " map scans, " +
-                    std::to_string(map.test_scans.size()) + " test scans, " +
-                    std::to_string(map.world.targets.size()) +
-                    " stable point returns; their positions are refitted as nuisance";
-  rep.notes.push_back(
-      "No world file: the scene was mapped under the base physics from the map scans. An "
-      "effect that displaces returns the same way in the map and the test scans (same speed, "
-      "same direction) is absorbed by the map; an out-and-back split exposes Doppler, latency "
-      "and motion distortion because they flip sign with the driving direction.");
-  return rep;
 }
 
 }  // namespace spinradar::diagnose

@@ -2,9 +2,14 @@
 // Scene model from the recording itself (no world file): strong returns of the map scans are
 // placed in the world with the trajectory under the base physics; locations seen in enough
 // scans become point targets. Map and test scans are disjoint so the effect is not fitted
-// into the map (issue 10).
+// into the map (issue 10). The map keeps its peaks, so it can be re-placed under any physics:
+// the mapped positions are themselves a function of the effect parameters (map-aware
+// regressors, re-simulation with the fitted effects; docs/diagnose.md).
+#include <array>
 #include <string>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "spinradar/core/polar_scan.hpp"
 #include "spinradar/sim/physics.hpp"
@@ -15,17 +20,35 @@ namespace spinradar::diagnose {
 
 struct SceneMapOptions {
   double min_contrast = 25.0;   ///< counts above the row median for a peak
-  double cluster_radius = 0.5;  ///< m
+  double cluster_radius = 1.0;  ///< m (wide: a wrong physics scatters a target's placements)
   double min_fraction = 0.5;    ///< of the map scans a location must be seen in
   double min_range = 4.0;       ///< m
 };
 
+/// One peak of a map scan as recorded (reported range and azimuth, recorded stamps).
+struct MapPeak {
+  int scan = 0;
+  double range = 0, azimuth = 0;  ///< m, rad clockwise (reported)
+  double stamp = 0;               ///< s, recorded stamp of the row
+  double first_stamp = 0, sweep = 0.25;  ///< of the scan
+};
+
 struct SceneMap {
-  sim::World world;
+  sim::World world;                        ///< one point target per stable cluster
+  std::vector<std::vector<MapPeak>> members;  ///< peaks of each target
   std::vector<int> map_scans, test_scans;  ///< indices into the recording
   std::string split;                       ///< description of the split used
   int peaks = 0;                           ///< peaks placed
 };
+
+/// World position of a map peak when the recording is read under `physics` (the inverse of
+/// predictTarget for that one return).
+Eigen::Vector2d placePeak(const MapPeak& p, const sim::Trajectory& traj,
+                          const sim::PhysicsConfig& physics);
+
+/// The map's targets re-placed under `physics` (same peaks, same clusters, same order).
+sim::World replaceMap(const SceneMap& map, const sim::Trajectory& traj,
+                      const sim::PhysicsConfig& physics);
 
 /// Which scans build the map: "early-late" (first half maps, second half is diagnosed),
 /// "late-early", or "out-back" (the half before the largest heading reversal maps).
