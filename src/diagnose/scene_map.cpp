@@ -11,7 +11,7 @@ namespace spinradar::diagnose {
 namespace {
 
 struct Cluster {
-  double sx = 0, sy = 0, sdb = 0;
+  double sx = 0, sy = 0;
   int n = 0, last_scan = -1, scans = 0;
   std::vector<MapPeak> peaks;
   double x() const { return sx / n; }
@@ -131,6 +131,7 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
         pk.stamp = geo.stamp[gi];
         pk.first_stamp = geo.firstStamp();
         pk.sweep = geo.sweep;
+        pk.power = v;
         const Eigen::Vector2d wp = placePeak(pk, traj, base);
         const double wx = wp.x(), wy = wp.y();
         ++m.peaks;
@@ -159,8 +160,6 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
         c.peaks.push_back(pk);
         c.sx += wx;
         c.sy += wy;
-        c.sdb += v / sensor.power_scale - sensor.radar_constant_db +
-                 (40.0 - sensor.range_gain_db_per_decade) * std::log10(std::max(r, 1.0));
         ++c.n;
         if (c.last_scan != k) {
           c.last_scan = k;
@@ -172,12 +171,29 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
   const int need = std::max(2, static_cast<int>(std::ceil(opt.min_fraction * m.map_scans.size())));
   for (const Cluster& c : clusters) {
     if (c.scans < need) continue;
+    // One peak per scan, the strongest: weaker local maxima in the same cluster are sidelobes
+    // of the main return (or a weaker neighbour) and would pull the mean aside.
+    std::vector<MapPeak> kept;
+    for (const MapPeak& pk : c.peaks) {
+      auto it = std::find_if(kept.begin(), kept.end(),
+                             [&](const MapPeak& q) { return q.scan == pk.scan; });
+      if (it == kept.end())
+        kept.push_back(pk);
+      else if (pk.power > it->power)
+        *it = pk;
+    }
     sim::Target t;
-    t.x = c.x();
-    t.y = c.y();
-    t.rcs = c.sdb / c.n;
+    double sdb = 0;
+    for (const MapPeak& pk : kept) {
+      const Eigen::Vector2d wp = placePeak(pk, traj, base);
+      t.x += wp.x() / kept.size();
+      t.y += wp.y() / kept.size();
+      sdb += pk.power / sensor.power_scale - sensor.radar_constant_db +
+             (40.0 - sensor.range_gain_db_per_decade) * std::log10(std::max(pk.range, 1.0));
+    }
+    t.rcs = sdb / kept.size();
     m.world.targets.push_back(t);
-    m.members.push_back(c.peaks);
+    m.members.push_back(kept);
   }
   return m;
 }

@@ -31,6 +31,7 @@ struct MapPeak {
   double range = 0, azimuth = 0;  ///< m, rad clockwise (reported)
   double stamp = 0;               ///< s, recorded stamp of the row
   double first_stamp = 0, sweep = 0.25;  ///< of the scan
+  double power = 0;               ///< counts at the peak
 };
 
 struct SceneMap {
