@@ -3,6 +3,7 @@
 // (5, before/after); the scene built from the recording (no world file) is in scene_map.cpp.
 #include "spinradar/diagnose/diagnose.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -16,7 +17,10 @@ double Observation::radialVelocity() const {
   return vx * std::cos(azimuth) - vy * std::sin(azimuth);
 }
 
-DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
+namespace {
+
+// The catalogue stage (steps 1-5 of docs/diagnose.md) on the stamps as given.
+DiagnoseReport catalogue(const DiagnoseInput& in, const DiagnoseOptions& opt) {
   const auto t_start = std::chrono::steady_clock::now();
   DiagnoseReport rep;
   rep.base = in.base;
@@ -35,6 +39,63 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
   // 5. Re-simulate with the effects added one at a time; residual statistics per step.
   detail::resimulateWithEffects(in, opt, as, rep);
   rep.locate = locateResiduals(rep.obs, false);
+  rep.runtime_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return rep;
+}
+
+bool baseHasBursts(const sim::PhysicsConfig& base) {
+  const auto it = base.extra.find("stamp_bursts");
+  if (it == base.extra.end() || it->is_null()) return false;
+  return !(it->is_boolean() && !it->get<bool>());
+}
+
+}  // namespace
+
+DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt) {
+  return opt.timing ? diagnoseRecording(in, opt, true) : catalogue(in, opt);
+}
+
+DiagnoseReport diagnoseRecording(const DiagnoseInput& in, const DiagnoseOptions& opt,
+                                 bool with_world, const std::string& split) {
+  const auto t_start = std::chrono::steady_clock::now();
+  TimingReport timing = analyseStamps(in.scans, in.sensor.rotation_hz, opt.timing_options);
+  DiagnoseOptions o = opt;
+  o.timing = false;
+  auto run = [&](const DiagnoseInput& x) {
+    return with_world ? catalogue(x, o) : diagnoseWithoutWorld(x, o, split);
+  };
+  DiagnoseReport rep;
+  if (timing.bursts && !baseHasBursts(in.base)) {
+    // Bursty stamps are arrival times: the catalogue stage works on the fitted firing times.
+    DiagnoseInput fixed = in;
+    fixed.scans = correctedStamps(in.scans, timing);
+    timing.notes.push_back("The catalogue stage used the uniform firing times fitted from the "
+                           "stamps, not the recorded (bursty) stamps.");
+    rep = run(fixed);
+  } else {
+    if (baseHasBursts(in.base))
+      timing.notes.push_back("The base physics already renders stamp bursts (" +
+                             in.base.extra["stamp_bursts"].dump() +
+                             "): compare its size and spacing with the fit above.");
+    rep = run(in);
+  }
+  // Rotation jitter with nominal stamps: without motion distortion the simulator renders the
+  // whole scan from the pose at instant_fraction of the (stretched) sweep.
+  const double sweep = timing.period_mean > 0 ? timing.period_mean : 1.0 / in.sensor.rotation_hz;
+  const double tau_fixed =
+      in.base.motion_distortion ? -1.0 : opt.conventions.instant_fraction * sweep;
+  analyseJitter(rep.obs, rep.scans, rep.sigma_r, rep.sigma_az, tau_fixed,
+                !with_world || opt.target_nuisance, timing, opt.timing_options);
+  double offset = 0, offset_sd = 0;
+  for (const auto& e : rep.effects)
+    if (e.effect == Effect::TimestampOffset) {
+      offset = e.value;
+      offset_sd = std::max(e.stddev, 1e-12);
+    }
+  adviseTiming(timing, offset, offset_sd);
+  rep.timing = std::move(timing);
+  if (!rep.timing.findings.empty()) rep.mismatch_found = true;
   rep.runtime_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return rep;

@@ -109,6 +109,7 @@ nlohmann::json DiagnoseReport::toJson() const {
                {"sigma_azimuth_rad", sigma_az},
                {"effects_tested", effect_names_tested}};
   j["scene_model"] = scene_model;
+  j["timing"] = timing.toJson();
   j["runtime_s"] = runtime_s;
   return j;
 }
@@ -121,6 +122,7 @@ std::string DiagnoseReport::summaryMarkdown() const {
     << " targets, " << outliers << " outliers dropped; family-wise alpha with Holm correction "
     << "and BIC).\n\n";
   s << "Scene model: " << scene_model << ".\n\n";
+  s << timing.summaryMarkdown() << "\n";
   s << "Residual RMS (position, re-simulated): " << fmt(before.position_rms) << " m before, "
     << fmt(after.position_rms) << " m after. Range " << fmt(before.range_rms) << " -> "
     << fmt(after.range_rms) << " m, azimuth " << fmt(before.azimuth_rms * 180 / M_PI) << " -> "
@@ -159,6 +161,28 @@ std::string DiagnoseReport::summaryMarkdown() const {
   s << "\nFitted physics: `" << fitted.toJson().dump() << "`\n";
   s << "\nRuntime " << fmt(runtime_s, 3) << " s.\n";
   return s.str();
+}
+
+void writeTimingReport(const TimingReport& timing, const std::string& out_dir,
+                       const std::string& why_no_catalogue) {
+  namespace fs = std::filesystem;
+  fs::create_directories(out_dir);
+  nlohmann::json j;
+  j["mismatch_found"] = !timing.findings.empty();
+  j["verdict"] = timing.findings.empty() ? "no timing effect found" : "timing effect found";
+  j["catalogue"] = "not run: " + why_no_catalogue;
+  j["timing"] = timing.toJson();
+  std::ostringstream md;
+  md << "# spinradar diagnose (timing only)\n\n**Verdict: "
+     << (timing.findings.empty() ? "no timing effect found" : "timing effect found")
+     << "**\n\nCatalogue stage not run: " << why_no_catalogue << "\n\n"
+     << timing.summaryMarkdown();
+  for (const std::string name : {"report.json", "summary.md", "summary.txt"}) {
+    const std::string path = (fs::path(out_dir) / name).string();
+    std::ofstream f(path);
+    if (!f) throw std::runtime_error(path + ": cannot write");
+    f << (name == "report.json" ? j.dump(2) + "\n" : md.str());
+  }
 }
 
 void writeReport(const DiagnoseReport& rep, const std::string& out_dir) {

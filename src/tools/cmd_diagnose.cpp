@@ -18,6 +18,8 @@ using namespace spinradar;
 
 struct DiagnoseArgs {
   std::string recording, trajectory, world, base, out, map_split = "early-late";
+  std::string format = "oxford";
+  bool timing_only = false;
   double range_resolution = 0;  // 0: sensor.json or the default
   int first_scan = 0, max_scans = -1;
   double alpha = 0.001;
@@ -62,20 +64,44 @@ sim::SensorConfig sensorFor(const DiagnoseArgs& a, const std::string& dir,
   return s;
 }
 
+void printTiming(const diagnose::TimingReport& t) {
+  std::cout << "timing: stamps " << t.stamp_model << " (" << t.scans << " scans)";
+  for (const auto& f : t.findings)
+    std::cout << "; " << f.name << " = " << f.value << " +- " << f.stddev << " " << f.unit
+              << " (z " << f.significance << ", " << f.scans << " scans)";
+  std::cout << "\n";
+  for (const auto& s : t.advice) std::cout << "  timing model: " << s << "\n";
+}
+
 void run(const DiagnoseArgs& a) {
   ScanFolderOptions fo;
   if (a.range_resolution > 0) fo.range_resolution = a.range_resolution;
   const std::string dir = recordingFolder(a);
-  ScanFolder folder(dir, ScanFormat::Oxford, fo);
+  ScanFolder folder(dir, parseScanFormat(a.format), fo);
   if (folder.empty()) throw std::runtime_error(a.recording + ": no radar scans found");
   diagnose::DiagnoseInput in;
   const size_t end = a.max_scans < 0 ? folder.size()
                                      : std::min(folder.size(), size_t(a.first_scan + a.max_scans));
   for (size_t i = a.first_scan; i < end; ++i) in.scans.push_back(folder.load(i));
   if (in.scans.empty()) throw std::runtime_error(a.recording + ": no scans in the chosen range");
+  in.sensor = sensorFor(a, dir, in.scans);
+  // The timing stage needs only the stamps: run it alone when asked, or when no trajectory is
+  // given, or when the catalogue stage cannot run on this recording (report why).
+  auto timingOnly = [&](const std::string& why) {
+    diagnose::TimingReport t =
+        diagnose::analyseStamps(in.scans, in.sensor.rotation_hz, diagnose::TimingOptions{});
+    diagnose::adviseTiming(t, 0, 0);
+    diagnose::writeTimingReport(t, a.out, why);
+    std::cout << "catalogue stage not run: " << why << "\n";
+    printTiming(t);
+    std::cout << "report in " << a.out << "\n";
+  };
+  if (a.timing_only || a.trajectory.empty()) {
+    timingOnly(a.timing_only ? "--timing-only" : "no --trajectory given");
+    return;
+  }
   if (!a.world.empty()) in.world = sim::World::load(a.world);
   in.trajectory = sim::Trajectory::loadCsv(a.trajectory);
-  in.sensor = sensorFor(a, dir, in.scans);
   if (!a.base.empty()) in.base = sim::PhysicsConfig::load(a.base);
   for (auto& s : in.scans) s.range_resolution = in.sensor.range_resolution;
 
@@ -83,9 +109,13 @@ void run(const DiagnoseArgs& a) {
   opt.alpha = a.alpha;
   opt.seed = a.seed;
   opt.resimulate_after = !a.no_resimulate;
-  const diagnose::DiagnoseReport rep = a.world.empty()
-                                           ? diagnose::diagnoseWithoutWorld(in, opt, a.map_split)
-                                           : diagnose::diagnose(in, opt);
+  diagnose::DiagnoseReport rep;
+  try {
+    rep = diagnose::diagnoseRecording(in, opt, !a.world.empty(), a.map_split);
+  } catch (const std::runtime_error& e) {
+    timingOnly(e.what());
+    return;
+  }
   diagnose::writeReport(rep, a.out);
   std::cout << (rep.mismatch_found ? "mismatch found:" : "no significant mismatch");
   for (const auto& e : rep.effects)
@@ -93,6 +123,7 @@ void run(const DiagnoseArgs& a) {
               << " (z " << e.significance << ")";
   std::cout << "\nresidual rms " << rep.before.position_rms << " m -> " << rep.after.position_rms
             << " m; report in " << a.out << "\n";
+  printTiming(rep.timing);
 }
 
 }  // namespace
@@ -104,8 +135,13 @@ SPINRADAR_COMMAND(
       auto a = std::make_shared<DiagnoseArgs>();
       app.add_option("--recording", a->recording, "Oxford polar PNG folder (radar/<stamp>.png) or a rosbag (.bag) of spinradar/RadarScan")
           ->required();
-      app.add_option("--trajectory", a->trajectory, "Sensor trajectory CSV t,x,y,yaw")
-          ->required();
+      app.add_option("--trajectory", a->trajectory,
+                     "Sensor trajectory CSV t,x,y,yaw (without it only the timing stage runs)");
+      app.add_option("--format", a->format,
+                     "Scan format of the recording: oxford (default), boreas, mulran, auto");
+      app.add_flag("--timing-only", a->timing_only,
+                   "Only the timing stage (stamps: bursts, period per scan); no world or "
+                   "trajectory needed");
       app.add_option("--world", a->world,
                      "World JSON (targets, walls); without it the scene is mapped from part of "
                      "the recording (--map-split)");

@@ -14,6 +14,7 @@
 #include "spinradar/diagnose/associate.hpp"
 #include "spinradar/diagnose/predict.hpp"
 #include "spinradar/diagnose/stats.hpp"
+#include "spinradar/diagnose/timing.hpp"
 #include "spinradar/sim/physics.hpp"
 #include "spinradar/sim/scene.hpp"
 #include "spinradar/sim/sensor_config.hpp"
@@ -38,6 +39,10 @@ struct DiagnoseOptions {
   /// Treat every target's world position as a nuisance parameter (2 per target): for scene
   /// models mapped from the recording, whose positions carry the effect's average.
   bool target_nuisance = false;
+  /// Timing stage (timing.hpp): stamp analysis first (bursty stamps are replaced by the fitted
+  /// uniform firing times before the catalogue stage), rotation jitter from the residuals after.
+  bool timing = true;
+  TimingOptions timing_options;
   ModelConventions conventions;
   ViewOptions views;
   PeakOptions peaks;
@@ -113,6 +118,7 @@ struct DiagnoseReport {
   double sigma_r = 0, sigma_az = 0;      ///< robust noise of one residual
   double runtime_s = 0;
   std::string scene_model = "world file";  ///< or how the map was built from the recording
+  TimingReport timing;                   ///< stamps, rotation jitter, timing model to use
   nlohmann::json toJson() const;
   std::string summaryMarkdown() const;
 };
@@ -124,8 +130,19 @@ DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt = {}
 DiagnoseReport diagnoseWithoutWorld(const DiagnoseInput& in, const DiagnoseOptions& opt = {},
                                     const std::string& split = "early-late");
 
+/// The whole diagnosis of a recording: timing stage on every scan (bursty stamps corrected),
+/// then diagnose() (`with_world`) or diagnoseWithoutWorld(split), then rotation jitter from the
+/// residuals and the timing advice. diagnose() with opt.timing does the same with a world.
+DiagnoseReport diagnoseRecording(const DiagnoseInput& in, const DiagnoseOptions& opt,
+                                 bool with_world, const std::string& split = "early-late");
+
 /// Writes report.json, summary.md, summary.txt and PNG plots into out_dir (created).
 void writeReport(const DiagnoseReport& report, const std::string& out_dir);
+
+/// report.json and summary.md of the timing stage alone (no world/trajectory diagnosis), with
+/// the reason the catalogue stage did not run.
+void writeTimingReport(const TimingReport& timing, const std::string& out_dir,
+                       const std::string& why_no_catalogue);
 
 /// Residual figures grouped by scan, azimuth sector, range band, speed, turning and heading.
 std::vector<LocateRow> locateResiduals(const std::vector<Observation>& obs, bool use_fit);

@@ -1,0 +1,339 @@
+// Timing stage, part 2: rotation jitter from target residuals, the findings with their
+// evidence, the timing model to use (advice), and the report sections.
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include <Eigen/Dense>
+
+#include "spinradar/diagnose/diagnose.hpp"
+#include "spinradar/diagnose/stats.hpp"
+#include "spinradar/diagnose/timing.hpp"
+#include "timing_detail.hpp"
+
+namespace spinradar::diagnose {
+namespace {
+
+std::string fmt(double v, int prec = 4) {
+  std::ostringstream s;
+  s << std::setprecision(prec) << v;
+  return s.str();
+}
+
+// Sub-nanosecond RMS is rounding of a perfect fit: print it as 0.
+double usRms(double s) { return s < 1e-9 ? 0.0 : s * 1e6; }
+
+std::string scansWord(int k) { return std::to_string(k) + (k == 1 ? " scan" : " scans"); }
+
+/// Scan-to-scan figures from few scans: say how weak.
+std::string spreadEvidence(int k) {
+  if (k < 3) return "only " + scansWord(k) + ": no spread can be estimated";
+  const double rel = 1.0 / std::sqrt(2.0 * (k - 1));
+  std::string s = scansWord(k) + "; the spread itself is known to about +-" +
+                  fmt(100 * rel, 2) + " % (1/sqrt(2(K-1)))";
+  if (k < 10) s += ": weak evidence, record more scans";
+  return s;
+}
+
+}  // namespace
+
+namespace detail {
+
+void addStampFindings(TimingReport& t, const TimingOptions& opt) {
+  if (t.bursts) {
+    TimingFinding f;
+    f.name = "stamp_bursts";
+    f.parameter = "spacing";
+    f.unit = "s";
+    f.value = t.burst_spacing;
+    f.stddev = t.burst_spacing_sd;
+    f.significance = t.burst_z;
+    f.p = t.burst_p;
+    f.scans = t.scans;
+    const int packets = static_cast<int>(std::lround(
+        static_cast<double>(t.rows) / std::max(1, t.burst_size)));
+    f.evidence = "about " + std::to_string(packets) + " packets in " + scansWord(t.scans) +
+                 "; " + fmt(100 * t.burst_size_agreement, 3) +
+                 " % of the packets seen between two gaps have exactly " +
+                 std::to_string(t.burst_size) + " rows";
+    f.details = {{"size", t.burst_size},
+                 {"spacing_s", t.burst_spacing},
+                 {"spacing_sd_s", t.burst_spacing_sd},
+                 {"gap_s", t.burst_gap},
+                 {"size_agreement", t.burst_size_agreement},
+                 {"phase", t.burst_phase},
+                 {"delay", "not identifiable from stamps (a timestamp offset)"}};
+    t.findings.push_back(f);
+  }
+  if (t.scans >= 2 && t.period_p < opt.alpha && t.period_rel_std > opt.min_period_variation) {
+    TimingFinding f;
+    f.name = "rotation_period_variation";
+    f.parameter = "relative std of the period (stamps)";
+    f.value = t.period_rel_std;
+    f.stddev = t.period_rel_std_sd;
+    f.significance = chi2ToZ(t.period_chi2, t.period_dof);
+    f.p = t.period_p;
+    f.scans = t.scans;
+    f.evidence = spreadEvidence(t.scans);
+    f.details = {{"period_s", t.period}, {"period_sd_s", t.period_sd}};
+    t.findings.push_back(f);
+  }
+}
+
+}  // namespace detail
+
+void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_r,
+                   double sigma_az, double tau_fixed, bool target_nuisance, TimingReport& t,
+                   const TimingOptions& opt) {
+  const int to = static_cast<int>(Effect::TimestampOffset);
+  if (sigma_r <= 0 || sigma_az <= 0 || scans < 2) return;
+  // Scans with enough returns and a usable regressor.
+  std::vector<int> per_scan(scans, 0);
+  for (const auto& o : obs)
+    if (o.scan >= 0 && o.scan < scans) ++per_scan[o.scan];
+  std::vector<int> col(scans, -1), used;
+  for (int k = 0; k < scans; ++k)
+    if (per_scan[k] >= 3) {
+      col[k] = static_cast<int>(used.size());
+      used.push_back(k);
+    }
+  if (used.size() < 3) {
+    t.notes.push_back("Rotation jitter not tested: fewer than 3 scans with 3 or more target "
+                      "returns.");
+    return;
+  }
+  std::vector<int> tcol;  // target -> first nuisance column
+  int n_nuis = 0;
+  if (target_nuisance) {
+    int max_t = 0;
+    for (const auto& o : obs) max_t = std::max(max_t, o.target + 1);
+    tcol.assign(max_t, -1);
+    for (const auto& o : obs)
+      if (o.scan >= 0 && o.scan < scans && col[o.scan] >= 0 && tcol[o.target] < 0) {
+        tcol[o.target] = n_nuis;
+        n_nuis += 2;
+      }
+  }
+  const int K = static_cast<int>(used.size());
+  // Residuals after the catalogue fit; own robust scales and outliers (the catalogue's inlier
+  // flags were set without the per-scan stretches, so a large jitter would be cut away there).
+  std::vector<const Observation*> rows;
+  for (const auto& o : obs)
+    if (o.scan >= 0 && o.scan < scans && col[o.scan] >= 0) rows.push_back(&o);
+  std::vector<bool> keep(rows.size(), true);
+  double sr = sigma_r, sa = sigma_az;
+  OlsFit fit;
+  std::vector<int> idx;
+  for (int pass = 0; pass < 3; ++pass) {
+    idx.clear();
+    for (size_t i = 0; i < rows.size(); ++i)
+      if (keep[i]) idx.push_back(static_cast<int>(i));
+    const int m = static_cast<int>(idx.size());
+    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(2 * m, n_nuis + K);
+    Eigen::VectorXd y(2 * m);
+    for (int j = 0; j < m; ++j) {
+      const Observation& o = *rows[idx[j]];
+      const double tau = tau_fixed < 0 ? o.tau : tau_fixed;
+      y(j) = o.fit_r / sr;
+      y(m + j) = o.fit_az / sa;
+      X(j, n_nuis + col[o.scan]) = -tau * o.dr[to] / sr;
+      X(m + j, n_nuis + col[o.scan]) = -tau * o.daz[to] / sa;
+      if (target_nuisance)
+        for (int q = 0; q < 2; ++q) {
+          X(j, tcol[o.target] + q) = o.tr[q] / sr;
+          X(m + j, tcol[o.target] + q) = o.taz[q] / sa;
+        }
+    }
+    fit = ols(X, y);
+    if (pass == 2) break;
+    std::vector<double> rr, ra;
+    for (int j = 0; j < m; ++j) {
+      rr.push_back(fit.resid(j) * sr);
+      ra.push_back(fit.resid(m + j) * sa);
+    }
+    const double nsr = std::max(robustSigma(rr), 1e-6), nsa = std::max(robustSigma(ra), 1e-7);
+    for (int j = 0; j < m; ++j)
+      keep[idx[j]] = std::fabs(rr[j]) < opt.outlier_sigma * nsr &&
+                     std::fabs(ra[j]) < opt.outlier_sigma * nsa;
+    sr = nsr;
+    sa = nsa;
+  }
+  t.jitter_tested = true;
+  t.stretch.assign(scans, 0.0);
+  t.stretch_sd.assign(scans, 0.0);
+  Eigen::VectorXd e(K);
+  Eigen::MatrixXd cov(K, K);
+  double vbar = 0, mean = 0;
+  for (int a = 0; a < K; ++a) {
+    e(a) = fit.coef(n_nuis + a);
+    for (int b = 0; b < K; ++b) cov(a, b) = fit.cov(n_nuis + a, n_nuis + b);
+    t.stretch[used[a]] = e(a);
+    t.stretch_sd[used[a]] = std::sqrt(std::max(cov(a, a), 0.0));
+    vbar += cov(a, a) / K;
+    mean += e(a) / K;
+  }
+  // Wald test that every scan has the same stretch: differences to the last scan.
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(K - 1, K);
+  for (int a = 0; a + 1 < K; ++a) {
+    C(a, a) = 1;
+    C(a, K - 1) = -1;
+  }
+  const Eigen::VectorXd ce = C * e;
+  const Eigen::MatrixXd cc = C * cov * C.transpose();
+  // An exact fit (noise-free simulation) leaves no variance: nothing to test.
+  const double q = cc.norm() > 0 ? ce.dot(cc.ldlt().solve(ce)) : 0.0;
+  double ss = 0;
+  for (int a = 0; a < K; ++a) ss += (e(a) - mean) * (e(a) - mean);
+  const double wmean = mean;
+  t.jitter_dof = K - 1;
+  t.jitter_chi2 = q;
+  t.jitter_p = chi2Sf(q, K - 1);
+  // Spread of the true stretches: sample variance about the mean minus the estimation noise.
+  const double var = std::max(0.0, ss / (K - 1) - vbar);
+  t.jitter_std = std::sqrt(var);
+  t.jitter_std_sd = var > 0 ? std::sqrt(2.0 / (K - 1)) * (var + vbar) / (2 * t.jitter_std) : 0;
+  if (t.jitter_p < opt.alpha && t.jitter_std > 0) {
+    TimingFinding f;
+    f.name = "rotation_jitter";
+    f.parameter = "relative std of the rotation period (targets)";
+    f.value = t.jitter_std;
+    f.stddev = t.jitter_std_sd;
+    f.significance = detail::chi2ToZ(q, K - 1);
+    f.p = t.jitter_p;
+    f.scans = K;
+    f.evidence = spreadEvidence(K) + "; per-scan stretch known to +-" +
+                 fmt(std::sqrt(vbar), 2) + " (mean 1-sigma)";
+    f.details = {{"stretch", t.stretch}, {"stretch_sd", t.stretch_sd}, {"mean_stretch", wmean}};
+    t.findings.push_back(f);
+  }
+}
+
+void adviseTiming(TimingReport& t, double offset_s, double offset_sd) {
+  t.advice.clear();
+  auto has = [&](const std::string& n) {
+    return std::any_of(t.findings.begin(), t.findings.end(),
+                       [&](const TimingFinding& f) { return f.name == n; });
+  };
+  const double ms = 1e3;
+  if (t.bursts) {
+    t.advice.push_back(
+        "Stamps are packet arrival times, not firing times: rows come in packets of " +
+        std::to_string(t.burst_size) + " (stamps " + fmt(t.burst_spacing * 1e6, 4) +
+        " us apart inside a packet, a " + fmt(t.burst_gap * ms, 4) +
+        " ms step between packets). Use uniform firing times t_i = c_k + i * T_k / " +
+        std::to_string(t.rows_per_rotation) + " per scan (fitted T = " +
+        fmt(t.period_mean * ms, 6) + " ms) instead of the stamps. The delay between a "
+        "packet's acquisition and its arrival is a constant timestamp offset, measurable only "
+        "against a trajectory. Simulator: \"stamp_bursts\": {\"size\": " +
+        std::to_string(t.burst_size) + ", \"spacing\": " + fmt(t.burst_spacing, 4) + "}.");
+  } else {
+    const bool jitter = has("rotation_jitter");
+    t.advice.push_back("Stamps are uniform (" + fmt(usRms(t.stamp_rms_uniform), 3) +
+                       " us RMS about one line per scan, row interval " +
+                       fmt(t.row_interval * 1e6, 5) + " us)" +
+                       (jitter ? ", but nominal: see the rotation jitter below."
+                               : ": use them as firing times."));
+  }
+  if (has("rotation_period_variation"))
+    t.advice.push_back("The rotation period in the stamps varies by " +
+                       fmt(100 * t.period_rel_std, 3) +
+                       " % (std) from scan to scan: use each scan's own period (first-stamp "
+                       "differences or the stamp slope), not the nominal one.");
+  if (has("rotation_jitter"))
+    t.advice.push_back(
+        "The stamps are nominal but the true rotation period varies by " +
+        fmt(100 * t.jitter_std, 3) + " % (std) from scan to scan (the targets' positions "
+        "stretch with it): the stamps do not follow the rotation. Take firing times from a "
+        "per-scan period the sensor measures (encoder/clock), or simulate with "
+        "\"rotation_jitter\": " + fmt(t.jitter_std, 3) + ".");
+  if (offset_sd > 0)
+    t.advice.push_back("Stamps are offset from the firing times by " + fmt(offset_s * ms, 4) +
+                       " +- " + fmt(offset_sd * ms, 2) + " ms (catalogue effect "
+                       "timestamp_offset): correct them by " + fmt(-offset_s * ms, 4) +
+                       " ms, or simulate with \"timestamp_offset\": " + fmt(offset_s, 4) + "." +
+                       (t.bursts ? " Here it is measured against the firing times fitted from "
+                                   "the bursty stamps: it is the packet delay (arrival minus "
+                                   "acquisition of the packet's last row)."
+                                 : ""));
+  if (t.findings.empty() && offset_sd <= 0)
+    t.advice.push_back("No timing effect found: uniform firing at the recorded stamps is the "
+                       "timing model to use.");
+}
+
+nlohmann::json TimingReport::toJson() const {
+  nlohmann::json j;
+  j["stamp_model"] = stamp_model;
+  j["scans"] = scans;
+  j["rows"] = rows;
+  j["rows_per_rotation"] = rows_per_rotation;
+  j["row_interval_s"] = row_interval;
+  j["stamp_rms_about_uniform_s"] = stamp_rms_uniform;
+  j["stamp_rms_about_model_s"] = stamp_rms_model;
+  j["bursts"] = {{"found", bursts},       {"size", burst_size},
+                 {"spacing_s", burst_spacing}, {"spacing_sd_s", burst_spacing_sd},
+                 {"gap_s", burst_gap},    {"z", burst_z},
+                 {"p_value", burst_p},    {"size_agreement", burst_size_agreement},
+                 {"phase", burst_phase}};
+  j["period"] = {{"per_scan_s", period},      {"per_scan_sd_s", period_sd},
+                 {"mean_s", period_mean},     {"relative_std", period_rel_std},
+                 {"relative_std_sd", period_rel_std_sd}, {"chi2", period_chi2},
+                 {"dof", period_dof},         {"p_value", period_p},
+                 {"start_gaps_s", start_gap}};
+  j["jitter"] = {{"tested", jitter_tested},   {"stretch_per_scan", stretch},
+                 {"stretch_sd", stretch_sd},  {"std", jitter_std},
+                 {"std_sd", jitter_std_sd},   {"chi2", jitter_chi2},
+                 {"dof", jitter_dof},         {"p_value", jitter_p}};
+  j["findings"] = nlohmann::json::array();
+  for (const auto& f : findings)
+    j["findings"].push_back({{"name", f.name},
+                             {"parameter", f.parameter},
+                             {"unit", f.unit},
+                             {"value", f.value},
+                             {"stddev", f.stddev},
+                             {"significance", f.significance},
+                             {"p_value", f.p},
+                             {"scans", f.scans},
+                             {"evidence", f.evidence},
+                             {"details", f.details}});
+  j["advice"] = advice;
+  j["notes"] = notes;
+  return j;
+}
+
+std::string TimingReport::summaryMarkdown() const {
+  std::ostringstream s;
+  s << "## Timing (" << scansWord(scans) << ", " << rows << " rows)\n\n";
+  s << "Stamp model: **" << stamp_model << "**";
+  if (bursts)
+    s << " (packets of " << burst_size << ", spacing " << fmt(burst_spacing * 1e6, 4) << " +- "
+      << fmt(burst_spacing_sd * 1e6, 2) << " us, gap " << fmt(burst_gap * 1e3, 4)
+      << " ms, z " << fmt(burst_z, 3) << ")";
+  s << "; stamps about one line per scan: " << fmt(usRms(stamp_rms_uniform), 4)
+    << " us RMS, about the model: " << fmt(usRms(stamp_rms_model), 4) << " us RMS.\n\n";
+  if (!period.empty()) {
+    s << "Rotation period from the stamps (ms):";
+    for (size_t k = 0; k < period.size(); ++k) s << " " << fmt(period[k] * 1e3, 7);
+    s << "; relative spread " << fmt(100 * period_rel_std, 3) << " % (chi2 "
+      << fmt(period_chi2, 4) << ", " << period_dof << " dof).\n\n";
+  }
+  if (jitter_tested)
+    s << "Rotation jitter from the targets: std " << fmt(100 * jitter_std, 3) << " +- "
+      << fmt(100 * jitter_std_sd, 2) << " % (chi2 " << fmt(jitter_chi2, 4) << ", " << jitter_dof
+      << " dof, p " << fmt(jitter_p, 3) << ").\n\n";
+  if (!findings.empty()) {
+    s << "| timing effect | parameter | value | stddev | z | scans | evidence |\n"
+         "|---|---|---|---|---|---|---|\n";
+    for (const auto& f : findings)
+      s << "| " << f.name << " | " << f.parameter << (f.unit.empty() ? "" : " (" + f.unit + ")")
+        << " | " << fmt(f.value, 5) << " | " << fmt(f.stddev, 3) << " | "
+        << fmt(f.significance, 3) << " | " << f.scans << " | " << f.evidence << " |\n";
+    s << "\n";
+  }
+  s << "**Timing model to use:**\n\n";
+  for (const auto& a : advice) s << "- " << a << "\n";
+  for (const auto& n : notes) s << "- Note: " << n << "\n";
+  return s.str();
+}
+
+}  // namespace spinradar::diagnose

@@ -1,0 +1,260 @@
+// Issue 10: timing effects in the diagnosis. Simulated recordings with one timing effect hidden
+// (stamp bursts, rotation jitter, timestamp offset) must be named with their parameter within
+// 15 %, null recordings must give no timing finding, with and without a world file; the real
+// samples in ../shared/realdata are checked against their hand-read stamps.
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+
+#include <gtest/gtest.h>
+
+#include "../../src/sim/render_model.hpp"  // the simulator's RNG: realised per-scan stretches
+#include "diagnose/diagnose_fixtures.hpp"
+#include "spinradar/core/scan_folder.hpp"
+#include "spinradar/core/scan_io.hpp"
+
+using namespace spinradar;
+using namespace spinradar::diagnose;
+using namespace spinradar::diagnose::testing;
+
+namespace {
+
+const nlohmann::json kNone = nlohmann::json::object();  // no effects
+
+bool hasFinding(const TimingReport& t, const std::string& name) {
+  for (const auto& f : t.findings)
+    if (f.name == name) return true;
+  return false;
+}
+
+const TimingFinding* finding(const TimingReport& t, const std::string& name) {
+  for (const auto& f : t.findings)
+    if (f.name == name) return &f;
+  return nullptr;
+}
+
+void print(const char* what, const DiagnoseReport& rep) {
+  std::cout << what << ": " << rep.obs.size() << " obs, " << rep.scans << " scans\n";
+  for (const auto& e : rep.effects)
+    std::cout << "  catalogue " << e.name << " = " << e.value << " +- " << e.stddev << "\n";
+  for (const auto& f : rep.timing.findings)
+    std::cout << "  timing " << f.name << " = " << f.value << " +- " << f.stddev << " (z "
+              << f.significance << ")\n";
+  if (rep.timing.jitter_tested)
+    std::cout << "  jitter std " << rep.timing.jitter_std << " chi2 " << rep.timing.jitter_chi2
+              << " dof " << rep.timing.jitter_dof << "\n";
+  for (const auto& a : rep.timing.advice) std::cout << "  advice: " << a << "\n";
+}
+
+// 8 m/s with turns both ways (the latency case of test_concealed).
+Drive turning() { return {{{0.8, 8.0, 0.0}, {1.0, 8.0, 0.35}, {1.0, 6.0, -0.35}}, {-5, 0, 0.0}}; }
+// 5 s at 8 m/s, turns both ways: room for 16 moving scans (from scan 2 at 4 Hz).
+Drive longTurning() {
+  return {{{0.8, 8.0, 0.0}, {1.5, 8.0, 0.35}, {1.5, 8.0, -0.35}, {1.2, 8.0, 0.2}}, {-8, 0, 0.0}};
+}
+// 6 m/s loop with turns both ways and a speed change (test_no_world).
+Drive loop() {
+  return {{{1.0, 6.0, 0.0}, {1.5, 6.0, 0.4}, {1.0, 3.0, 0.0}, {1.5, 6.0, -0.4}}, {-5, 0, 0.0}};
+}
+
+// ---- stamps alone: no world, no trajectory needed ----
+
+std::vector<PolarScan> stampsOnly(const nlohmann::json& hidden, int n, uint64_t seed) {
+  sim::World empty;  // stamps do not depend on the scene
+  return makeInput(empty, loop(), sim::PhysicsConfig::fromJson(hidden), n, seed).scans;
+}
+
+TEST(TimingStamps, BurstsOfSixteenFoundAndFitted) {
+  const auto scans = stampsOnly({{"stamp_bursts", {{"size", 16}, {"spacing", 135e-6}}}}, 3, 5);
+  const TimingReport t = analyseStamps(scans, 4.0);
+  ASSERT_TRUE(t.bursts);
+  EXPECT_EQ(t.burst_size, 16);
+  EXPECT_NEAR(t.burst_spacing, 135e-6, 0.15 * 135e-6);
+  EXPECT_NEAR(t.burst_gap, 16 * 625e-6 - 15 * 135e-6, 2e-6);  // 7.975 ms
+  EXPECT_NEAR(t.period_mean, 0.25, 1e-6);
+  ASSERT_TRUE(hasFinding(t, "stamp_bursts"));
+  EXPECT_FALSE(hasFinding(t, "rotation_period_variation"));
+  // The corrected stamps are the uniform firing times (delay 0 here): within a microsecond.
+  const auto fixed = correctedStamps(scans, t);
+  for (int a = 0; a < fixed[1].azimuths; ++a)
+    EXPECT_NEAR((fixed[1].stamp_ns[a] - fixed[1].stamp_ns[0]) * 1e-9, a * 625e-6, 1e-6);
+  EXPECT_FALSE(hasFinding(analyseStamps(fixed, 4.0), "stamp_bursts"));
+}
+
+TEST(TimingStamps, OtherPacketSizeAndSpacing) {
+  const auto scans =
+      stampsOnly({{"stamp_bursts", {{"size", 10}, {"spacing", 300e-6}, {"delay", 0.004}}}}, 2, 6);
+  const TimingReport t = analyseStamps(scans, 4.0);
+  ASSERT_TRUE(t.bursts);
+  EXPECT_EQ(t.burst_size, 10);
+  EXPECT_NEAR(t.burst_spacing, 300e-6, 0.15 * 300e-6);
+  EXPECT_DOUBLE_EQ(t.burst_size_agreement, 1.0);
+}
+
+TEST(TimingStamps, UniformStampsGiveNoFinding) {
+  for (uint64_t seed : {7u, 8u}) {
+    const TimingReport t = analyseStamps(stampsOnly(nlohmann::json::object(), 4, seed), 4.0);
+    EXPECT_FALSE(t.bursts);
+    EXPECT_TRUE(t.findings.empty()) << t.toJson().dump();
+    EXPECT_EQ(t.stamp_model, "uniform");
+  }
+}
+
+TEST(TimingStamps, StampsWrittenInMicrosecondsStayUniform) {
+  // The Oxford PNG layout truncates stamps to microseconds: no pattern may be read into that.
+  auto scans = stampsOnly(nlohmann::json::object(), 3, 9);
+  for (auto& s : scans)
+    for (auto& st : s.stamp_ns) st = st / 1000 * 1000 + 137;  // truncation plus a constant
+  const TimingReport t = analyseStamps(scans, 4.0);
+  EXPECT_TRUE(t.findings.empty()) << t.toJson().dump();
+}
+
+// ---- with a world file: the catalogue stage runs on the corrected stamps ----
+
+DiagnoseReport withWorld(const nlohmann::json& hidden, const nlohmann::json& base, int n,
+                         uint64_t seed, const Drive& drive = turning()) {
+  const sim::World world = randomWorld(seed, 90, 55.0, false);
+  DiagnoseInput in = makeInput(world, drive, sim::PhysicsConfig::fromJson(hidden), n, seed);
+  in.base = sim::PhysicsConfig::fromJson(base);
+  return spinradar::diagnose::diagnose(in, {});
+}
+
+TEST(TimingWorld, BurstsNamedAndCatalogueStaysClean) {
+  const DiagnoseReport rep =
+      withWorld({{"stamp_bursts", {{"size", 16}, {"spacing", 135e-6}}}}, kNone, 6, 21);
+  print("bursts, world", rep);
+  ASSERT_TRUE(hasFinding(rep.timing, "stamp_bursts"));
+  EXPECT_EQ(rep.timing.burst_size, 16);
+  EXPECT_NEAR(rep.timing.burst_spacing, 135e-6, 0.15 * 135e-6);
+  EXPECT_TRUE(rep.effects.empty());  // the stamps were corrected before the catalogue stage
+  EXPECT_TRUE(rep.mismatch_found);
+  EXPECT_NE(rep.toJson()["timing"]["advice"][0].get<std::string>().find("packet"),
+            std::string::npos);
+}
+
+TEST(TimingWorld, TimestampOffsetNamedInTheTimingAdvice) {
+  const DiagnoseReport rep = withWorld({{"timestamp_offset", 0.03}}, kNone, 6, 22);
+  print("offset, world", rep);
+  ASSERT_FALSE(rep.effects.empty());
+  EXPECT_EQ(rep.effects.front().name, "timestamp_offset");
+  EXPECT_NEAR(rep.effects.front().value, 0.03, 0.15 * 0.03);
+  EXPECT_FALSE(rep.timing.bursts);
+  bool named = false;
+  for (const auto& a : rep.timing.advice)
+    named = named || (a.find("timestamp_offset") != std::string::npos &&
+                      a.find("correct them by -") != std::string::npos);
+  EXPECT_TRUE(named);
+  EXPECT_FALSE(hasFinding(rep.timing, "rotation_jitter"));
+}
+
+/// The simulator's per-scan stretches for makeInput's scans (renderScan(k): key 2k + 1).
+double realisedJitterStd(uint64_t seed, double jitter, int first, int n) {
+  std::vector<double> e;
+  double mean = 0;
+  for (int k = first; k < first + n; ++k) {
+    sim::detail::Rng rng(seed * 0x9E3779B97F4A7C15ull ^ (uint64_t(k) * 2 + 1));
+    e.push_back(jitter * rng.normal());
+    mean += e.back() / n;
+  }
+  double ss = 0;
+  for (double x : e) ss += (x - mean) * (x - mean);
+  return std::sqrt(ss / (n - 1));
+}
+
+// Rotation jitter hides in the firing times only (stamps stay nominal), so it is seen only
+// through where the targets appear: a stretch e_k shifts a row's true time by e_k * tau (up to
+// 0.25 e_k s at the end of the sweep). At 3 % std that is up to ~7 ms, i.e. 6 cm at 8 m/s and
+// ~2.5 mrad of yaw at 0.35 rad/s (10 cm at 40 m): a few bins, well above the peak noise, so
+// each scan's stretch is measured to a fraction of the spread. 1 % would sit at the edge.
+TEST(TimingWorld, RotationJitterNamedWithItsStd) {
+  const nlohmann::json md = {{"motion_distortion", true}};
+  nlohmann::json hidden = md;
+  hidden["rotation_jitter"] = 0.03;
+  const int n = 16;
+  const uint64_t seed = 23;
+  const DiagnoseReport rep = withWorld(hidden, md, n, seed, longTurning());
+  print("jitter, world", rep);
+  const double truth = realisedJitterStd(seed, 0.03, 2, n);
+  std::cout << "  realised std " << truth << "\n";
+  const TimingFinding* f = finding(rep.timing, "rotation_jitter");
+  ASSERT_NE(f, nullptr);
+  EXPECT_NEAR(f->value, truth, 0.15 * truth);
+  EXPECT_FALSE(rep.timing.bursts);
+}
+
+TEST(TimingWorld, NullDrivesGiveNoTimingFinding) {
+  for (uint64_t seed : {24u, 25u}) {
+    const DiagnoseReport rep = withWorld(kNone, kNone, 6, seed);
+    print("null, world", rep);
+    EXPECT_TRUE(rep.timing.findings.empty()) << "seed " << seed;
+    EXPECT_FALSE(rep.mismatch_found) << "seed " << seed;
+  }
+}
+
+// ---- without a world file: scene mapped from the recording ----
+
+DiagnoseReport withoutWorld(const nlohmann::json& hidden, const nlohmann::json& base,
+                            uint64_t seed) {
+  const sim::World world = randomWorld(seed, 90, 55.0, false);
+  DiagnoseInput in = makeInput(world, loop(), sim::PhysicsConfig::fromJson(hidden), 16, seed);
+  in.base = sim::PhysicsConfig::fromJson(base);
+  return diagnoseRecording(in, {}, false, "early-late");
+}
+
+TEST(TimingNoWorld, BurstsNamedAndNullClean) {
+  const DiagnoseReport bursts =
+      withoutWorld({{"stamp_bursts", {{"size", 16}, {"spacing", 135e-6}}}}, kNone, 81);
+  print("bursts, no world", bursts);
+  ASSERT_TRUE(hasFinding(bursts.timing, "stamp_bursts"));
+  EXPECT_EQ(bursts.timing.burst_size, 16);
+  EXPECT_NEAR(bursts.timing.burst_spacing, 135e-6, 0.15 * 135e-6);
+  EXPECT_TRUE(bursts.effects.empty());
+  const DiagnoseReport null = withoutWorld(kNone, kNone, 83);
+  print("null, no world", null);
+  EXPECT_TRUE(null.timing.findings.empty());
+  EXPECT_FALSE(null.mismatch_found);
+}
+
+// ---- real samples (../shared/realdata) ----
+
+std::string shared() {
+#ifdef SPINRADAR_SHARED_DIR
+  return SPINRADAR_SHARED_DIR;
+#else
+  return "";
+#endif
+}
+
+TEST(TimingRealData, OxfordStampsAreBurstsOfSixteen) {
+  const std::string dir = shared() + "/realdata/oxford_2019-01-10-14-36-48";
+  if (shared().empty() || !std::filesystem::exists(dir))
+    GTEST_SKIP() << "real data not found (" << dir << "); set SPINRADAR_SHARED_DIR";
+  ScanFolder folder(dir, ScanFormat::Oxford);
+  std::vector<PolarScan> scans;
+  for (size_t i = 0; i < folder.size(); ++i) scans.push_back(folder.load(i));
+  ASSERT_EQ(scans.size(), 3u);
+  const TimingReport t = analyseStamps(scans, 4.0);
+  std::cout << t.summaryMarkdown();
+  ASSERT_TRUE(t.bursts);
+  EXPECT_NEAR(t.burst_size, 16, 1);
+  EXPECT_NEAR(t.burst_spacing, 135e-6, 0.15 * 135e-6);  // README: ~135 us inside a packet
+  EXPECT_NEAR(t.row_interval, 625e-6, 10e-6);           // README: mean 625 us
+  EXPECT_GT(t.burst_gap, 5e-3);                          // README: ~8 ms gap
+  EXPECT_GT(t.stamp_rms_uniform, 10 * t.stamp_rms_model);
+}
+
+TEST(TimingRealData, MulranBurstyBoreasRtUniform) {
+  const std::string m = shared() + "/realdata/mulran/1564718976161407002.csv";
+  const std::string b = shared() + "/realdata/boreas_rt/test_frame.png";
+  if (shared().empty() || !std::filesystem::exists(m) || !std::filesystem::exists(b))
+    GTEST_SKIP() << "real data not found (" << m << ", " << b << "); set SPINRADAR_SHARED_DIR";
+  const TimingReport tm = analyseStamps({loadMulranCsv(m)}, 4.0);
+  std::cout << tm.summaryMarkdown();
+  EXPECT_TRUE(tm.bursts);
+  const TimingReport tb = analyseStamps({loadBoreasPng(b)}, 4.0);
+  std::cout << tb.summaryMarkdown();
+  EXPECT_FALSE(tb.bursts);
+  EXPECT_EQ(tb.stamp_model, "uniform");
+}
+
+}  // namespace
