@@ -64,8 +64,10 @@ sim::World replaceMap(const SceneMap& map, const sim::Trajectory& traj,
 
 SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajectory& traj,
                        const sim::SensorConfig& sensor, const sim::PhysicsConfig& base,
-                       const std::string& split, const SceneMapOptions& opt) {
+                       const std::string& split, const SceneMapOptions& opt,
+                       const sim::PhysicsConfig* cluster_physics) {
   SceneMap m;
+  const sim::PhysicsConfig& cph = cluster_physics ? *cluster_physics : base;
   const int n = static_cast<int>(scans.size());
   if (n < 4) throw std::runtime_error("scene map: need at least 4 scans (2 to map, 2 to test)");
   int cut = n / 2;
@@ -132,7 +134,7 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
         pk.first_stamp = geo.firstStamp();
         pk.sweep = geo.sweep;
         pk.power = v;
-        const Eigen::Vector2d wp = placePeak(pk, traj, base);
+        const Eigen::Vector2d wp = placePeak(pk, traj, cph);
         const double wx = wp.x(), wy = wp.y();
         ++m.peaks;
         const int cx = static_cast<int>(std::floor(wx / cell)),

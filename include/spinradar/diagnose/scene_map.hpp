@@ -52,9 +52,13 @@ sim::World replaceMap(const SceneMap& map, const sim::Trajectory& traj,
                       const sim::PhysicsConfig& physics);
 
 /// Which scans build the map: "early-late" (first half maps, second half is diagnosed),
-/// "late-early", or "out-back" (the half before the largest heading reversal maps).
+/// "late-early", "out-back" (the scans before the heading has turned by 90 degrees map, when
+/// the drive reverses its heading), or "auto" (out-back when the drive reverses, otherwise
+/// early-late). Peaks are grouped into targets as placed under `cluster_physics` (default: the
+/// base; a fitted physics groups them more tightly), the targets are placed under `base`.
 SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajectory& traj,
                        const sim::SensorConfig& sensor, const sim::PhysicsConfig& base,
-                       const std::string& split = "early-late", const SceneMapOptions& opt = {});
+                       const std::string& split = "early-late", const SceneMapOptions& opt = {},
+                       const sim::PhysicsConfig* cluster_physics = nullptr);
 
 }  // namespace spinradar::diagnose
