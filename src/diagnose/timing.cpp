@@ -250,6 +250,8 @@ TimingReport analyseStamps(const std::vector<PolarScan>& scans, double rotation_
   // Standard errors are floored at the stamp quantum: a perfect fit is not infinitely precise.
   const double q2 = opt.stamp_quantum * opt.stamp_quantum / 12.0;
   const int P = t.rows_per_rotation;
+  std::vector<int> row0(K, 0);  // first row of each scan in the stacked fit
+  for (int k = 1; k < K; ++k) row0[k] = row0[k - 1] + static_cast<int>(rows[k - 1].t.size());
   double dt_sum = 0;
   for (int k = 0; k < K; ++k) {
     const double dt = fit.f.coef(2 * k + 1);
@@ -257,7 +259,30 @@ TimingReport analyseStamps(const std::vector<PolarScan>& scans, double rotation_
     for (int idx : rows[k].index) m += idx;
     m /= static_cast<double>(rows[k].index.size());
     for (int idx : rows[k].index) sxx += (idx - m) * (idx - m);
-    const double v = std::max(fit.f.cov(2 * k + 1, 2 * k + 1), q2 / std::max(sxx, 1.0));
+    // Stamp errors are correlated inside a packet (a late packet delays all its rows), so the
+    // row-level OLS variance is optimistic: also take the slope variance from the residuals
+    // averaged over blocks (packets, or 16 rows for uniform stamps), and keep the larger.
+    const int block = t.bursts ? t.burst_size : 16;
+    const int phase = t.bursts ? t.burst_phase[k] : 0;
+    std::map<int, std::pair<double, double>> sums;  // block -> (sum residual, sum index)
+    std::map<int, int> counts;
+    for (size_t j = 0; j < rows[k].index.size(); ++j) {
+      const int idx = rows[k].index[j];
+      const int b = detail::packetFirst(idx, block, phase);
+      sums[b].first += fit.f.resid(row0[k] + static_cast<int>(j));
+      sums[b].second += idx;
+      ++counts[b];
+    }
+    double s2b = 0, sxb = 0;
+    for (const auto& [b, sr] : sums) {
+      const double c = counts[b];
+      s2b += (sr.first / c) * (sr.first / c);
+      sxb += (sr.second / c - m) * (sr.second / c - m);
+    }
+    const int nb = static_cast<int>(sums.size());
+    const double v_block = nb > 2 && sxb > 0 ? s2b / (nb - 2) / sxb : 0.0;
+    const double v = std::max({fit.f.cov(2 * k + 1, 2 * k + 1), v_block,
+                               q2 / std::max(sxx, 1.0)});
     dt_sum += dt;
     t.period.push_back(dt * P);
     t.period_sd.push_back(std::sqrt(v) * P);
