@@ -21,6 +21,7 @@ namespace {
 struct Work {
   std::vector<uint8_t> column;
   std::vector<float> threshold;
+  std::vector<int16_t> floor;
   cv::Mat x, ref, fx, fref, prod, corr;  // rows x padded length
 };
 Work& work() {
@@ -236,6 +237,7 @@ ChirpDopplerResult estimateChirpDoppler(const PolarScan& scan, const ChirpDopple
   Work& w = work();
   // Noise floor per range bin over the rotation: median + robust spread (the floor follows range).
   w.threshold.assign(L, 0.f);
+  w.floor.assign(L, 0);
   w.column.resize(N);
   std::vector<uint8_t> dev(N);
   for (int b = 0; b < L; ++b) {
@@ -246,10 +248,22 @@ ChirpDopplerResult estimateChirpDoppler(const PolarScan& scan, const ChirpDopple
     auto mid = w.column.begin() + n / 2;
     std::nth_element(w.column.begin(), mid, w.column.begin() + n);
     const int med = *mid;
+    w.floor[b] = int16_t(med);
     for (int i = 0; i < n; ++i) dev[i] = uint8_t(std::abs(int(w.column[i]) - med));
     auto dmid = dev.begin() + n / 2;
     std::nth_element(dev.begin(), dmid, dev.begin() + n);
     w.threshold[b] = float(med + std::max(o.min_floor_margin, o.floor_sigmas * 1.4826 * *dmid));
+  }
+  // Smooth the threshold along range: its bin-to-bin jitter (integer medians) is common to all
+  // rows, and noise poking through it would correlate at zero lag and bias small shifts to 0.
+  {
+    const int h = 32;
+    std::vector<double> cum(L + 1, 0.0);
+    for (int b = 0; b < L; ++b) cum[b + 1] = cum[b] + w.threshold[b];
+    for (int b = 0; b < L; ++b) {
+      const int lo = std::max(0, b - h), hi = std::min(L, b + h + 1);
+      w.threshold[b] = float((cum[hi] - cum[lo]) / (hi - lo));
+    }
   }
 
   const int P = cv::getOptimalDFTSize(L + K + 1);
@@ -261,10 +275,21 @@ ChirpDopplerResult estimateChirpDoppler(const PolarScan& scan, const ChirpDopple
   for (int a = 0; a < N; ++a) {
     if (!valid(a)) continue;
     const uint8_t* p = scan.row(a) + b0;
+    // The row's own floor level (per-azimuth gain jitter) as the median of its offsets from the
+    // per-bin floor: without it a whole smooth floor profile, which no Doppler shifts, would
+    // leak above the threshold on loud rows and pull the correlation peak towards zero lag.
+    int hist[511] = {};
+    for (int b = 0; b < L; ++b) ++hist[int(p[b]) - w.floor[b] + 255];
+    int offset = 0;
+    for (int i = 0, acc = 0; i < 511; ++i)
+      if ((acc += hist[i]) * 2 >= L) {
+        offset = i - 255;
+        break;
+      }
     float* x = w.x.ptr<float>(a);
     double e = 0;
     for (int b = 0; b < L; ++b) {
-      const float v = std::max(0.f, float(p[b]) - w.threshold[b]);
+      const float v = std::max(0.f, float(p[b]) - w.threshold[b] - float(offset));
       x[b] = v;
       e += double(v) * v;
     }
@@ -367,6 +392,7 @@ ChirpDopplerResult estimateChirpDoppler(const PolarScan& scan, const ChirpDopple
   } else {
     v << "no alternating-chirp Doppler: beta*|v| = " << out.beta_v << " +- " << out.beta_v_sigma
       << " m (p = " << out.fit.p << ")";
+    if (out.speed) v << ", |v| = " << *out.speed << " +- " << *out.speed_sigma << " m/s given beta " << *o.beta << " s";
   }
   out.verdict = v.str();
   return out;

@@ -57,7 +57,7 @@ ChirpDopplerOptions givenBeta(double beta = kBeta) {
 }  // namespace
 
 TEST(ChirpDoppler, SpeedFromOneScanGivenBeta) {
-  for (double v : {10.0, 20.0}) {
+  for (double v : {1.0, 10.0, 20.0}) {
     const PolarScan scan = simScan(v, 0.0, true);
     ASSERT_EQ(scan.chirp_up.size(), size_t(scan.azimuths));
     const auto r = estimateChirpDoppler(scan, givenBeta());
