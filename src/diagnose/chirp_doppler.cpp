@@ -100,19 +100,17 @@ ChirpShiftFit robustFit(const std::vector<RowShift>& m, const std::vector<double
   }
   r = Y - X * beta;
   Eigen::Matrix3d H = X.transpose() * W.asDiagonal() * X;
-  double s2 = 0, sw = 0, rms = 0;
+  double s2 = 0, rms = 0;
   int inl = 0;
   for (int i = 0; i < n; ++i) {
     s2 += W(i) * r(i) * r(i);
-    sw += W(i);
     if (std::abs(r(i)) < 3 * sigma) {
       rms += r(i) * r(i);
       ++inl;
     }
   }
-  // Weights are relative (correlation quality): scale so that they average 1 over the rows.
+  // Weights are relative (correlation quality x Cauchy): the WLS variance factor absorbs their scale.
   s2 /= std::max(1, n - 3);
-  const double wmean = sw / n;
   // Lag-1 correlation of residuals of adjacent rows (they share rows in the measurement).
   double num = 0, den = 0;
   for (int i = 0; i < n; ++i) {
@@ -123,7 +121,6 @@ ChirpShiftFit robustFit(const std::vector<RowShift>& m, const std::vector<double
   const double rho = den > 0 ? num / den : 0.0;
   f.inflation = std::max(1.0, 1.0 + 2.0 * rho);
   Eigen::Matrix3d cov = H.inverse() * s2 * f.inflation;
-  (void)wmean;
   f.a = beta(0);
   f.b = beta(1);
   f.c = beta(2);
