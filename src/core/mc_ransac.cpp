@@ -40,6 +40,16 @@ Eigen::Matrix2d cartesianCovariance(const Eigen::Vector2d& p, double range_sigma
   return (vr - vt) * u * u.transpose() + vt * Eigen::Matrix2d::Identity();
 }
 
+bool withinInlierGate(const Eigen::Vector2d& e, const Eigen::Vector2d& p,
+                      double inlier_threshold, double azimuth_sigma) {
+  const double thr2 = inlier_threshold * inlier_threshold;
+  const double r2 = std::max(p.squaredNorm(), 1e-6);
+  const double q = McRansac::kAzimuthQuantum * azimuth_sigma;
+  const double inv_tan2 = 1.0 / (thr2 + q * q * r2);
+  const double er2 = e.dot(p) * e.dot(p) / r2;
+  return er2 * (1.0 / thr2 - inv_tan2) + e.squaredNorm() * inv_tan2 < 1.0;
+}
+
 McRansac::McRansac(const EstimatorConfig& config) : config_(config) {}
 
 void McRansac::load(const std::vector<Keypoint>& k1, const std::vector<Keypoint>& k2,
@@ -50,7 +60,12 @@ void McRansac::load(const std::vector<Keypoint>& k1, const std::vector<Keypoint>
   x2_.resize(M);
   y2_.resize(M);
   dt_.resize(M);
+  ux_.resize(M);
+  uy_.resize(M);
+  inv_tan2_.resize(M);
   max_abs_dt_ = 0.0;
+  const double thr2 = config_.inlier_threshold * config_.inlier_threshold;
+  const double q2 = kAzimuthQuantum * kAzimuthQuantum * config_.azimuth_sigma * config_.azimuth_sigma;
   for (size_t i = 0; i < M; ++i) {
     const Keypoint& a = k1[matches[i].i1];
     const Keypoint& b = k2[matches[i].i2];
@@ -60,6 +75,10 @@ void McRansac::load(const std::vector<Keypoint>& k1, const std::vector<Keypoint>
     y2_[i] = b.y;
     dt_[i] = 1e-9 * static_cast<double>(b.stamp_ns - a.stamp_ns);  // Delta t_m
     max_abs_dt_ = std::max(max_abs_dt_, std::abs(dt_[i]));
+    const double r2 = std::max(b.x * b.x + b.y * b.y, 1e-6), r = std::sqrt(r2);
+    ux_[i] = b.x / r;
+    uy_[i] = b.y / r;
+    inv_tan2_[i] = 1.0 / (thr2 + q2 * r2);
   }
 }
 
@@ -141,7 +160,7 @@ bool McRansac::gaussNewton(const int* idx, int n, int iterations, Eigen::Vector3
 }
 
 int McRansac::selectInliers(const Eigen::Vector3d& varpi, std::vector<int>* inliers) const {
-  const double thr2 = config_.inlier_threshold * config_.inlier_threshold;
+  const double inv_thr2 = 1.0 / (config_.inlier_threshold * config_.inlier_threshold);
   const int M = static_cast<int>(x1_.size());
   int n = 0;
   if (inliers) inliers->clear();
@@ -151,6 +170,8 @@ int McRansac::selectInliers(const Eigen::Vector3d& varpi, std::vector<int>* inli
     const double* x1 = x1_.data(); const double* y1 = y1_.data();
     const double* x2 = x2_.data(); const double* y2 = y2_.data();
     const double* dt = dt_.data();
+    const double* ux = ux_.data(); const double* uy = uy_.data();
+    const double* it2 = inv_tan2_.data();
     for (int m = 0; m < M; ++m) {
       const double t = dt[m] * w;
       double a, b;
@@ -159,14 +180,16 @@ int McRansac::selectInliers(const Eigen::Vector3d& varpi, std::vector<int>* inli
       const double rx = dt[m] * vx, ry = dt[m] * vy;
       const double ex = x2[m] - (c * x1[m] - s * y1[m] + a * rx - b * ry);
       const double ey = y2[m] - (s * x1[m] + c * y1[m] + b * rx + a * ry);
-      n += (ex * ex + ey * ey < thr2) ? 1 : 0;
+      const double er = ex * ux[m] + ey * uy[m];
+      n += (er * er * (inv_thr2 - it2[m]) + (ex * ex + ey * ey) * it2[m] < 1.0) ? 1 : 0;
     }
     return n;
   }
   for (int m = 0; m < M; ++m) {
     const Eigen::Vector2d g = transformPoint(varpi, dt_[m], x1_[m], y1_[m]);
     const double ex = x2_[m] - g.x(), ey = y2_[m] - g.y();
-    if (ex * ex + ey * ey < thr2) {
+    const double er = ex * ux_[m] + ey * uy_[m];
+    if (er * er * (inv_thr2 - inv_tan2_[m]) + (ex * ex + ey * ey) * inv_tan2_[m] < 1.0) {
       ++n;
       if (inliers) inliers->push_back(m);
     }
