@@ -51,6 +51,17 @@ if(EXISTS ${PROJECT_SOURCE_DIR}/src/tools/cmd_odometry.cpp)
             --out ${_out}/grouped.csv --quiet --config ${_tt}/data/grouped_config.yaml)
   set_tests_properties(cli_odometry_grouped_config PROPERTIES
     PASS_REGULAR_EXPRESSION "estimator rigid" SKIP_RETURN_CODE 77)
+  # Alternating-chirp Doppler (Boreas-RT): the sample frame was recorded standing still.
+  if(EXISTS ${PROJECT_SOURCE_DIR}/src/tools/cmd_chirp_doppler.cpp)
+    add_test(NAME cli_chirp_doppler_boreas_rt
+      COMMAND bash ${_tt}/with_realdata.sh ${SPINRADAR_SHARED_DIR} ${_cli} chirp-doppler
+              --input ${SPINRADAR_SHARED_DIR}/realdata/boreas_rt/test_frame.png --beta 0.0502)
+    set_tests_properties(cli_chirp_doppler_boreas_rt PROPERTIES
+      PASS_REGULAR_EXPRESSION "test_frame.png: no alternating-chirp Doppler" SKIP_RETURN_CODE 77)
+    add_test(NAME cli_chirp_doppler_missing_file
+      COMMAND bash ${_tt}/expect_error.sh "error: /nonexistent/frame.png: no such file or folder"
+              ${_cli} chirp-doppler --input /nonexistent/frame.png --beta 0.05)
+  endif()
   if(TARGET spinradar_bag)
     add_test(NAME cli_bag_roundtrip
       COMMAND bash ${_tt}/bag_roundtrip.sh ${_cli} ${SPINRADAR_SHARED_DIR} ${_out}/bag)
