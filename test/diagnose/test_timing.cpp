@@ -182,6 +182,27 @@ TEST(TimingWorld, RotationJitterNamedWithItsStd) {
   EXPECT_FALSE(rep.timing.bursts);
 }
 
+// The catalogue effects leave no timing finding behind (their residual structure is the same
+// in every scan, so the per-scan stretches stay equal).
+TEST(TimingWorld, CatalogueEffectsGiveNoTimingFinding) {
+  const Drive walking = {{{1.0, 1.5, 0.0}, {2.0, 1.5, 0.15}, {1.0, 0.6, 0.0}, {2.0, 1.5, -0.15}},
+                         {0, 0, 0.3}};
+  const Drive straight = {{{1.5, 10.0, 0.0}, {1.5, 10.0, 0.03}}, {-10, -5, 0.1}};
+  struct C {
+    nlohmann::json hidden;
+    Drive drive;
+    uint64_t seed;
+  };
+  for (const C& c : {C{{{"doppler", 0.049}}, walking, 31}, C{{{"motion_distortion", true}}, straight, 32},
+                     C{{{"azimuth_offset", 0.0105}}, turning(), 33},
+                     C{{{"range_offset", -0.3}}, turning(), 34}}) {
+    const DiagnoseReport rep = withWorld(c.hidden, kNone, 6, c.seed, c.drive);
+    print(c.hidden.dump().c_str(), rep);
+    EXPECT_FALSE(rep.effects.empty()) << c.hidden.dump();
+    EXPECT_TRUE(rep.timing.findings.empty()) << c.hidden.dump();
+  }
+}
+
 TEST(TimingWorld, NullDrivesGiveNoTimingFinding) {
   for (uint64_t seed : {24u, 25u}) {
     const DiagnoseReport rep = withWorld(kNone, kNone, 6, seed);
@@ -213,6 +234,25 @@ TEST(TimingNoWorld, BurstsNamedAndNullClean) {
   print("null, no world", null);
   EXPECT_TRUE(null.timing.findings.empty());
   EXPECT_FALSE(null.mismatch_found);
+}
+
+// Without a world the jitter is detected but its spread is underestimated: the mapped target
+// positions (refitted per target) absorb part of each scan's shift, and on the loop's straight
+// 3 m/s stretch the test scans' stretches are hardly separable (measured: 1.1 % for a realised
+// 3.3 % here, 1.4 % with motion distortion on). So this case asserts the name only, and that
+// the spread is not overstated; the report says the value is a lower bound.
+// Base and recording without motion distortion: the whole scan is rendered from the pose at
+// mid-sweep, so a stretch e_k shifts it in time by e_k * T / 2 (the tau_fixed path).
+TEST(TimingNoWorld, RotationJitterDetected) {
+  const uint64_t seed = 85;
+  const DiagnoseReport rep = withoutWorld({{"rotation_jitter", 0.03}}, kNone, seed);
+  print("jitter, no world", rep);
+  const double truth = realisedJitterStd(seed, 0.03, 2 + 8, 8);  // the 8 test scans
+  std::cout << "  realised std (test scans) " << truth << "\n";
+  const TimingFinding* f = finding(rep.timing, "rotation_jitter");
+  ASSERT_NE(f, nullptr);
+  EXPECT_LT(f->value, 1.15 * truth);
+  EXPECT_NE(f->evidence.find("lower bound"), std::string::npos);
 }
 
 // ---- real samples (../shared/realdata) ----
