@@ -275,12 +275,25 @@ TEST(TimingRealData, OxfordStampsAreBurstsOfSixteen) {
   ASSERT_EQ(scans.size(), 3u);
   const TimingReport t = analyseStamps(scans, 4.0);
   std::cout << t.summaryMarkdown();
+  // Hand-read from the stamps (awk over the 1200 rows): 75 steps above 2 ms (mean 7863.5 us),
+  // 72 complete packets of 16 rows, mean step inside a complete packet 146.8 us (median step
+  // 133.9 us: arrivals clump, so some steps are ~8 us and others ~260 us); scan 1 starts with
+  // 14 rows of a packet (its first gap follows row 13). README: ~16 rows ~135 us apart.
   ASSERT_TRUE(t.bursts);
   EXPECT_NEAR(t.burst_size, 16, 1);
-  EXPECT_NEAR(t.burst_spacing, 135e-6, 0.15 * 135e-6);  // README: ~135 us inside a packet
-  EXPECT_NEAR(t.row_interval, 625e-6, 10e-6);           // README: mean 625 us
-  EXPECT_GT(t.burst_gap, 5e-3);                          // README: ~8 ms gap
-  EXPECT_GT(t.stamp_rms_uniform, 10 * t.stamp_rms_model);
+  EXPECT_EQ(t.burst_size, 16);
+  EXPECT_DOUBLE_EQ(t.burst_size_agreement, 1.0);
+  EXPECT_NEAR(t.burst_spacing, 146.8e-6, 0.05 * 146.8e-6);
+  EXPECT_NEAR(t.burst_spacing, 135e-6, 0.15 * 135e-6);
+  EXPECT_NEAR(t.burst_gap, 7863.5e-6, 0.01 * 7863.5e-6);
+  EXPECT_EQ(t.burst_phase.front(), 14);
+  EXPECT_NEAR(t.row_interval, 625e-6, 10e-6);  // README: mean 625 us
+  EXPECT_GT(t.stamp_rms_uniform, 5 * t.stamp_rms_model);
+  ASSERT_TRUE(hasFinding(t, "stamp_bursts"));
+  // Three scans: any scan-to-scan statement must say it is weak evidence.
+  for (const auto& f : t.findings)
+    if (f.name == "rotation_period_variation")
+      EXPECT_NE(f.evidence.find("weak evidence"), std::string::npos);
 }
 
 TEST(TimingRealData, MulranBurstyBoreasRtUniform) {
@@ -288,9 +301,15 @@ TEST(TimingRealData, MulranBurstyBoreasRtUniform) {
   const std::string b = shared() + "/realdata/boreas_rt/test_frame.png";
   if (shared().empty() || !std::filesystem::exists(m) || !std::filesystem::exists(b))
     GTEST_SKIP() << "real data not found (" << m << ", " << b << "); set SPINRADAR_SHARED_DIR";
+  // MulRan, hand-read: 25 steps above 2 ms (mean 6976.1 us), 24 complete packets of 16 rows
+  // with a mean step of 202.4 us inside (steps range from 5 to 650 us).
   const TimingReport tm = analyseStamps({loadMulranCsv(m)}, 4.0);
   std::cout << tm.summaryMarkdown();
-  EXPECT_TRUE(tm.bursts);
+  ASSERT_TRUE(tm.bursts);
+  EXPECT_EQ(tm.burst_size, 16);
+  EXPECT_NEAR(tm.burst_spacing, 202.4e-6, 0.05 * 202.4e-6);
+  EXPECT_NEAR(tm.burst_gap, 6976.1e-6, 0.01 * 6976.1e-6);
+  // Boreas-RT: stamps uniform at ~625 us (README), one scan.
   const TimingReport tb = analyseStamps({loadBoreasPng(b)}, 4.0);
   std::cout << tb.summaryMarkdown();
   EXPECT_FALSE(tb.bursts);
