@@ -44,6 +44,28 @@ std::string separatingDrive(Effect a, Effect b) {
   return "use a drive with speed changes, turns both ways, and targets all around the sensor.";
 }
 
+std::string revealingSplit(Effect e) {
+  switch (e) {
+    case Effect::MotionDistortion:
+      return "map and test must see the targets at other times in the sweep or at other "
+             "velocities: an out-and-back drive (--map-split out-back) or speed changes.";
+    case Effect::Doppler:
+      return "map and test must see the targets at other radial velocities: an out-and-back "
+             "drive (--map-split out-back) or a speed change between the halves.";
+    case Effect::TimestampOffset:
+      return "map and test must move or turn differently: an out-and-back drive "
+             "(--map-split out-back), speed changes, or turns of opposite sign in the halves.";
+    case Effect::AzimuthOffset:
+      return "map and test must see the targets from other places or headings: turns, "
+             "targets passed abeam, or an out-and-back drive (--map-split out-back).";
+    case Effect::RangeOffset:
+      return "map and test must see the same targets from other directions: an out-and-back "
+             "drive (--map-split out-back) or targets passed (ahead in one half, abeam or "
+             "behind in the other).";
+  }
+  return "";
+}
+
 std::string signatureOf(Effect e) {
   switch (e) {
     case Effect::MotionDistortion:

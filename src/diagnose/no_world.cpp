@@ -4,6 +4,7 @@
 // dependence on the parameter (map-aware regressors), the map noise is modelled per target
 // (GLS), and the re-simulation re-places the map under each trial physics.
 #include <array>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include <Eigen/Dense>
 
 #include "diagnose_steps.hpp"
+#include "spinradar/diagnose/advice.hpp"
 #include "spinradar/diagnose/diagnose.hpp"
 #include "spinradar/diagnose/scene_map.hpp"
 
@@ -107,6 +109,37 @@ DiagnoseReport diagnoseAgainstMap(const DiagnoseInput& in, const DiagnoseOptions
   detail::nameAndFitEffects(test, o, cands, rep, &mm);
   detail::resimulateWithEffects(test, o, as, rep, &mm);
   rep.locate = locateResiduals(rep.obs, false);
+  // How much of each signature the map cancels (map and test views see it alike): the
+  // map-aware regressor against the one a world file would give.
+  for (auto& c : rep.candidates) {
+    const int e = static_cast<int>(c.effect);
+    double n_map = 0, n_direct = 0;
+    for (const auto& ob : rep.obs) {
+      if (!ob.inlier) continue;
+      const Eigen::Vector2d& dp = mm.dpos[ob.target][e];
+      const double mr = ob.tr[0] * dp.x() + ob.tr[1] * dp.y();
+      const double ma = ob.taz[0] * dp.x() + ob.taz[1] * dp.y();
+      const double r = ob.dr[e] / rep.sigma_r, a = ob.daz[e] / rep.sigma_az;
+      const double r0 = (ob.dr[e] - mr) / rep.sigma_r, a0 = (ob.daz[e] - ma) / rep.sigma_az;
+      n_map += r * r + a * a;
+      n_direct += r0 * r0 + a0 * a0;
+    }
+    if (n_direct <= 0) continue;
+    c.absorbed = std::clamp(1.0 - n_map / n_direct, 0.0, 1.0);
+    bool found = false;
+    for (const auto& r : rep.effects) found = found || r.effect == c.effect;
+    if (!found && c.absorbed > 0.9) {
+      // Rough smallest change this split could detect (z = 4 on the map-aware signature,
+      // map noise ignored).
+      const double detectable = n_map > 0 ? 4.0 / std::sqrt(n_map) : INFINITY;
+      std::ostringstream n;
+      n << effectName(c.effect) << ": " << std::lround(100 * c.absorbed)
+        << "% of its signature is cancelled by the map (map and test scans see it alike); "
+        << "with this split only a change beyond about " << detectable << " "
+        << effectUnit(c.effect) << " would show. " << revealingSplit(c.effect);
+      rep.notes.push_back(n.str());
+    }
+  }
   std::ostringstream sm;
   sm << "built from the recording: " << map.split << "; " << map.map_scans.size()
      << " map scans, " << map.test_scans.size() << " test scans, "

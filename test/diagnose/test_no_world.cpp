@@ -16,6 +16,14 @@ using namespace spinradar::diagnose::testing;
 
 namespace {
 
+// Noise floor 28 dB below the radar constant (as in test_concealed.cpp).
+sim::SensorConfig noisySensor() {
+  sim::SensorConfig s = smallSensor();
+  s.noise_floor_db = s.radar_constant_db - 28.0;
+  s.clutter_db = 0.0;
+  return s;
+}
+
 struct Case {
   const char* name;
   nlohmann::json hidden;
@@ -25,6 +33,7 @@ struct Case {
   const char* split;   // the split --map-split auto must choose for this drive
   const char* expect;  // effect name, or "" for the null case
   double value;
+  bool noisy = false;
 };
 
 // Out and back: straight, a U-turn to the left, straight back past the same targets.
@@ -44,7 +53,8 @@ TEST_P(NoWorld, NamesAndFitsTheHiddenEffect) {
   const Case& c = GetParam();
   const sim::World world = randomWorld(c.seed, 90, 55.0, false);
   const DiagnoseInput in =
-      makeInput(world, c.drive, sim::PhysicsConfig::fromJson(c.hidden), c.scans, c.seed);
+      makeInput(world, c.drive, sim::PhysicsConfig::fromJson(c.hidden), c.scans, c.seed,
+                c.noisy ? noisySensor() : smallSensor());
   DiagnoseOptions opt;
   const DiagnoseReport rep = diagnoseWithoutWorld(in, opt, "auto");
   std::cout << c.name << ": " << rep.scene_model << "\n  " << rep.obs.size() << " obs, "
@@ -93,8 +103,37 @@ INSTANTIATE_TEST_SUITE_P(Diagnose, NoWorld, ::testing::Values(
   Case{"null_outback_c", nlohmann::json::object(), outBack(), 24, 88, "out-back", "", 0},
   Case{"null_loop_a", nlohmann::json::object(), loop(), 16, 83, "early-late", "", 0},
   Case{"null_loop_b", nlohmann::json::object(), loop(), 16, 84, "early-late", "", 0},
-  Case{"null_loop_c", nlohmann::json::object(), loop(), 16, 86, "early-late", "", 0}),
+  Case{"null_loop_c", nlohmann::json::object(), loop(), 16, 86, "early-late", "", 0},
+  // Weak returns (noise floor 28 dB below the radar constant): peaks scatter from scan to scan.
+  Case{"noisy_doppler", {{"doppler", 0.049}}, outBack(), 24, 181, "out-back", "doppler", 0.049, true},
+  Case{"noisy_range_offset", {{"range_offset", -0.3}}, outBack(), 24, 182, "out-back", "range_offset", -0.3, true},
+  Case{"noisy_azimuth_offset", {{"azimuth_offset", 0.008}}, outBack(), 24, 185, "out-back", "azimuth_offset", 0.008, true},
+  Case{"noisy_latency_35ms", {{"timestamp_offset", 0.035}}, outBack(), 24, 186, "out-back", "timestamp_offset", 0.035, true},
+  Case{"noisy_motion_distortion", {{"motion_distortion", true}}, outBack(), 24, 187, "out-back", "motion_distortion", 1.0, true},
+  Case{"noisy_null_a", nlohmann::json::object(), outBack(), 24, 183, "out-back", "", 0, true},
+  Case{"noisy_null_b", nlohmann::json::object(), loop(), 16, 184, "early-late", "", 0, true},
+  Case{"noisy_null_c", nlohmann::json::object(), loop(), 16, 188, "early-late", "", 0, true},
+  Case{"noisy_null_d", nlohmann::json::object(), outBack(), 24, 189, "out-back", "", 0, true}),
   [](const ::testing::TestParamInfo<Case>& i) { return std::string(i.param.name); });
 // clang-format on
+
+// A latency on a straight road at constant speed displaces map and test returns alike: the
+// map cancels it, and the report must say so (and which split would reveal it) rather than
+// only "no significant mismatch".
+TEST(NoWorldConcealed, LatencyOnAStraightRoadIsReportedAsCancelledByTheMap) {
+  const uint64_t seed = 191;
+  const sim::World world = randomWorld(seed, 90, 55.0, false);
+  const Drive straight{{{4.0, 8.0, 0.0}}, {-20, 3, 0.0}};
+  const DiagnoseInput in = makeInput(
+      world, straight, sim::PhysicsConfig::fromJson({{"timestamp_offset", 0.03}}), 14, seed);
+  const DiagnoseReport rep = diagnoseWithoutWorld(in, {}, "auto");
+  EXPECT_FALSE(rep.mismatch_found);
+  bool said = false;
+  for (const auto& n : rep.notes)
+    said = said || (n.find("timestamp_offset: 100% of its signature is cancelled by the map") !=
+                        std::string::npos &&
+                    n.find("out-back") != std::string::npos);
+  EXPECT_TRUE(said);
+}
 
 }  // namespace
