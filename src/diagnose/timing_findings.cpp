@@ -229,7 +229,8 @@ void adviseTiming(TimingReport& t, double offset_s, double offset_sd) {
         fmt(t.period_mean * ms, 6) + " ms) instead of the stamps. The delay between a "
         "packet's acquisition and its arrival is a constant timestamp offset, measurable only "
         "against a trajectory. Simulator: \"stamp_bursts\": {\"size\": " +
-        std::to_string(t.burst_size) + ", \"spacing\": " + fmt(t.burst_spacing, 4) + "}.");
+        std::to_string(t.burst_size) + ", \"spacing\": " + fmt(t.burst_spacing, 4) +
+        (offset_sd > 0 ? ", \"delay\": " + fmt(offset_s, 4) : std::string()) + "}.");
   } else {
     const bool jitter = has("rotation_jitter");
     t.advice.push_back("Stamps are uniform (" + fmt(usRms(t.stamp_rms_uniform), 3) +

@@ -132,6 +132,22 @@ TEST(TimingWorld, BurstsNamedAndCatalogueStaysClean) {
             std::string::npos);
 }
 
+// A packet delay (arrival after the packet's last row is acquired) is not in the stamps' shape:
+// after the correction it is left as a timestamp offset, which the catalogue stage measures.
+TEST(TimingWorld, BurstDelayMeasuredAsTimestampOffset) {
+  const DiagnoseReport rep = withWorld(
+      {{"stamp_bursts", {{"size", 16}, {"spacing", 135e-6}, {"delay", 0.02}}}}, kNone, 6, 26);
+  print("bursts + 20 ms delay, world", rep);
+  ASSERT_TRUE(rep.timing.bursts);
+  EXPECT_EQ(rep.timing.burst_size, 16);
+  ASSERT_FALSE(rep.effects.empty());
+  EXPECT_EQ(rep.effects.front().name, "timestamp_offset");
+  EXPECT_NEAR(rep.effects.front().value, 0.02, 0.15 * 0.02);
+  bool delay = false;
+  for (const auto& a : rep.timing.advice) delay = delay || a.find("packet delay") != std::string::npos;
+  EXPECT_TRUE(delay);
+}
+
 TEST(TimingWorld, TimestampOffsetNamedInTheTimingAdvice) {
   const DiagnoseReport rep = withWorld({{"timestamp_offset", 0.03}}, kNone, 6, 22);
   print("offset, world", rep);
