@@ -190,6 +190,7 @@ TEST(TimingWorld, RotationJitterNamedWithItsStd) {
   const uint64_t seed = 23;
   const DiagnoseReport rep = withWorld(hidden, md, n, seed, longTurning());
   print("jitter, world", rep);
+  for (const auto& f : rep.timing.findings) std::cout << "  evidence: " << f.evidence << "\n";
   const double truth = realisedJitterStd(seed, 0.03, 2, n);
   std::cout << "  realised std " << truth << "\n";
   const TimingFinding* f = finding(rep.timing, "rotation_jitter");
