@@ -8,6 +8,7 @@
 
 #include "spinradar/core/doppler.hpp"
 #include "spinradar/core/feature_extractor.hpp"
+#include "spinradar/core/keyframe_tracker.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/core/matcher.hpp"
 #include "spinradar/core/mc_ransac.hpp"
@@ -19,13 +20,14 @@ namespace spinradar {
 
 namespace {
 
-enum class Estimator { kRigid, kMc, kMcDoppler, kRefined };
+enum class Estimator { kRigid, kMc, kMcDoppler, kRefined, kKeyframe };
 
 Estimator parseEstimator(const std::string& name) {
   if (name == "rigid") return Estimator::kRigid;
   if (name == "mc") return Estimator::kMc;
   if (name == "mc_doppler") return Estimator::kMcDoppler;
   if (name == "refined") return Estimator::kRefined;
+  if (name == "keyframe") return Estimator::kKeyframe;
   throw std::invalid_argument("parameter 'estimator': unknown value '" + name + "'");
 }
 
@@ -64,6 +66,7 @@ struct Odometry::Impl {
   RigidRansac rigid;
   McRansac mc;
   RefinedEstimator refined;
+  KeyframeTracker keyframe;  ///< on top of refined for the keyframe estimator
 
   FrameBuffer prev, cur;
   bool has_prev = false;
@@ -86,6 +89,7 @@ struct Odometry::Impl {
     rigid.setConfig(c.estimator);
     mc.setConfig(c.estimator);
     refined.setConfig(c.estimator);
+    keyframe.setConfig(c.estimator);
     if (features_changed) extractor.reset();  // rebuilt with the new settings on demand
   }
 
@@ -113,6 +117,7 @@ struct Odometry::Impl {
     T_world.setIdentity();
     pose_cov.setZero();
     refined.reset();
+    keyframe.reset();
     corrected.clear();
     raw.clear();
   }
@@ -129,6 +134,7 @@ struct Odometry::Impl {
         return estimateMcDoppler(mc, a.keypoints, b.keypoints, matches, a.stamp_ns, b.stamp_ns,
                                  config.estimator.beta, corr1, corr2, m);
       case Estimator::kRefined:
+      case Estimator::kKeyframe:
         return refined.estimate(a, b, matches, corr1, corr2, m);
     }
     return false;
@@ -153,14 +159,23 @@ struct Odometry::Impl {
       t0 = std::chrono::steady_clock::now();
       MotionEstimate& m = res.motion;
       const bool ok = estimate(m);
+      if (ok && estimator == Estimator::kKeyframe) {
+        Eigen::Matrix3d T_new, P_new;
+        keyframe.track(cur.frame, T_world, pose_cov, config.features.nndr, m, T_new, P_new);
+        setPose(T_new, P_new);
+        dopplerCorrect(cur.frame.keypoints, m.velocity, config.estimator.beta, corr2);
+      } else if (!ok) {
+        keyframe.reset();  // the prediction below is not tied to the keyframe
+      }
       times.estimate_ms = msSince(t0);
       const double dt_ref = 1e-9 * static_cast<double>(cur.frame.stamp_ns - prev.frame.stamp_ns);
       if (ok) {
-        compound(m.T_12, m.T_12_cov);
+        if (estimator != Estimator::kKeyframe) compound(m.T_12, m.T_12_cov);
         last = m;
         has_last = true;
         res.ok = true;
-        doppler = estimator == Estimator::kMcDoppler || estimator == Estimator::kRefined;
+        doppler = estimator == Estimator::kMcDoppler || estimator == Estimator::kRefined ||
+                  estimator == Estimator::kKeyframe;
       } else if (has_last && dt_ref > 0.0) {
         // Estimation failed (too few matches, degenerate geometry): predict with the last
         // velocity so the trajectory stays continuous; res.ok = false reports the failure.
@@ -202,7 +217,12 @@ struct Odometry::Impl {
     Eigen::Matrix3d G = Eigen::Matrix3d::Identity();
     G.topLeftCorner<2, 2>() = R;
     pose_cov = F * pose_cov * F.transpose() + G * cov_12 * G.transpose();
-    T_world = T_world * T_12;
+    setPose(T_world * T_12, pose_cov);
+  }
+
+  void setPose(const Eigen::Matrix3d& T, const Eigen::Matrix3d& P) {
+    T_world = T;
+    pose_cov = P;
     // Re-orthonormalise the rotation against round-off over long runs.
     const double yaw = std::atan2(T_world(1, 0), T_world(0, 0));
     T_world.topLeftCorner<2, 2>() << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);

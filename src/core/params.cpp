@@ -21,7 +21,7 @@ void FeatureConfig::validate() const {
 
 void EstimatorConfig::validate() const {
   checkParamRanges(*this, "estimator");
-  checkOneOf(estimator, {"rigid", "mc", "mc_doppler", "refined"}, "estimator");
+  checkOneOf(estimator, {"rigid", "mc", "mc_doppler", "refined", "keyframe"}, "estimator");
 }
 
 }  // namespace spinradar

@@ -1,0 +1,226 @@
+#include "spinradar/core/keyframe_tracker.hpp"
+
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include "spinradar/core/doppler.hpp"
+#include "spinradar/core/lie.hpp"
+#include "spinradar/core/mc_ransac.hpp"
+#include "spinradar/core/undistort.hpp"
+
+namespace spinradar {
+
+namespace {
+
+/// T_ac = T_ab T_bc with first-order propagation over [x, y, yaw] (as Odometry::compound):
+/// p' = p + R(yaw) t, yaw' = yaw + dyaw; the two covariances independent.
+void compound(const Eigen::Matrix3d& T_ab, const Eigen::Matrix3d& P_ab, const Eigen::Matrix3d& T_bc,
+              const Eigen::Matrix3d& C_bc, Eigen::Matrix3d& T_ac, Eigen::Matrix3d& P_ac) {
+  const Eigen::Matrix2d R = T_ab.topLeftCorner<2, 2>();
+  const Eigen::Vector2d Rt = R * T_bc.topRightCorner<2, 1>();
+  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+  F(0, 2) = -Rt.y();
+  F(1, 2) = Rt.x();
+  Eigen::Matrix3d G = Eigen::Matrix3d::Identity();
+  G.topLeftCorner<2, 2>() = R;
+  P_ac = F * P_ab * F.transpose() + G * C_bc * G.transpose();
+  T_ac = T_ab * T_bc;
+}
+
+double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+
+}  // namespace
+
+KeyframeTracker::KeyframeTracker(const EstimatorConfig& config) : config_(config) {}
+
+void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d& xi,
+                                   const Eigen::Matrix3d& T_w, const Eigen::Matrix3d& P) {
+  // The keyframe's points as a static map: Doppler-corrected and moved to its reference
+  // time with its own velocity.
+  dopplerCorrect(f.keypoints, xi, config_.beta, tmp_kps_);
+  undistortPoints(tmp_kps_, xi, f.stamp_ns, key_pts_);
+  const cv::Mat& d = f.descriptors;
+  if (d.empty()) {
+    key_desc_ = cv::Mat();
+  } else {
+    if (key_desc_storage_.rows < d.rows || key_desc_storage_.cols != d.cols ||
+        key_desc_storage_.type() != d.type())
+      key_desc_storage_.create(std::max(d.rows + d.rows / 2, 64), d.cols, d.type());
+    key_desc_ = key_desc_storage_.rowRange(0, d.rows);
+    d.copyTo(key_desc_);
+  }
+  T_wj_ = T_w;
+  P_j_ = P;
+  T_jprev_.setIdentity();
+  C_jprev_.setZero();
+  key_inliers_ = 0;
+  has_key_ = true;
+  ++switches_;
+}
+
+bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3d& C_prior,
+                            const Eigen::Vector3d& xi_prior, const Eigen::Matrix3d& Cxi_prior,
+                            Eigen::Matrix3d& T, Eigen::Vector3d& xi,
+                            Eigen::Matrix<double, 6, 6>& cov) {
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  const double beta = config_.beta, sr = config_.range_sigma, sa = config_.azimuth_sigma;
+  const int n = static_cast<int>(qx_.size());
+  in_.assign(n, 1);
+  const Eigen::Matrix3d Wp = (C_prior + 1e-10 * Eigen::Matrix3d::Identity()).inverse();
+  const Eigen::Matrix3d Wv = Cxi_prior.inverse();
+  const Eigen::Vector3d prior_pose = se2::toXyYaw(T_prior);
+  Mat6 A;
+  double chi2 = 0.0;
+  int cnt = 0;
+  for (int it = 0; it < kIterations; ++it) {
+    // Gate: wide around the prediction first, narrower as the solution settles, at the
+    // inlier threshold from iteration 4 on.
+    const bool regate = it == 0 || it >= 2;
+    const double gate = it < 2 ? kPredictionGate : it < 4 ? 2.0 * config_.inlier_threshold
+                                                          : config_.inlier_threshold;
+    const double gate2 = gate * gate;
+    A.setZero();
+    Vec6 b = Vec6::Zero();
+    Eigen::Vector3d rp = se2::toXyYaw(T) - prior_pose;
+    rp(2) = wrapAngle(rp(2));
+    const Eigen::Matrix3d L = se2::leftPerturbationToXyYaw(T);
+    A.topLeftCorner<3, 3>() += L.transpose() * Wp * L;
+    b.head<3>() -= L.transpose() * Wp * rp;
+    A.bottomRightCorner<3, 3>() += Wv;
+    b.tail<3>() -= Wv * (xi - xi_prior);
+    const Eigen::Matrix2d CT = T.topLeftCorner<2, 2>();
+    const Eigen::Vector2d tT = T.topRightCorner<2, 1>();
+    const double vx = xi(0), vy = xi(1);
+    chi2 = 0.0;
+    cnt = 0;
+    for (int m = 0; m < n; ++m) {
+      if (!regate && !in_[m]) continue;
+      const double ux = ux_[m], uy = uy_[m];
+      const double d = beta * (ux * vx + uy * vy);
+      const Eigen::Vector2d pc(px_[m] + d * ux, py_[m] + d * uy);
+      const Eigen::Matrix3d E = se2::exp(tau_[m] * xi);
+      const Eigen::Matrix2d CE = E.topLeftCorner<2, 2>();
+      const Eigen::Vector2d g = CE * pc + E.topRightCorner<2, 1>();
+      const Eigen::Vector2d qh = CT * g + tT;
+      const Eigen::Vector2d q(qx_[m], qy_[m]);
+      const Eigen::Vector2d e = q - qh;
+      if (regate) in_[m] = e.squaredNorm() <= gate2;
+      if (!in_[m]) continue;
+      Eigen::Matrix<double, 2, 6> J;
+      J.leftCols<3>() = -se2::odot2(qh);
+      Eigen::Matrix<double, 2, 3> D;
+      D << beta * ux * ux, beta * ux * uy, 0.0, beta * uy * ux, beta * uy * uy, 0.0;
+      J.rightCols<3>() = -CT * (tau_[m] * se2::odot2(g) + CE * D);
+      const Eigen::Matrix2d CC = CT * CE;
+      const Eigen::Matrix2d S =
+          cartesianCovariance(q, sr, sa) + CC * cartesianCovariance(pc, sr, sa) * CC.transpose();
+      const Eigen::Matrix2d Si = S.inverse();
+      const Eigen::Matrix<double, 6, 2> JtW = J.transpose() * Si;
+      A.noalias() += JtW * J;
+      b.noalias() -= JtW * e;
+      chi2 += e.dot(Si * e);
+      ++cnt;
+    }
+    if (cnt < kMinInliers) return false;
+    Eigen::LDLT<Mat6> ldlt(A);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
+    const Vec6 dx = ldlt.solve(b);
+    if (!dx.allFinite()) return false;
+    T = se2::exp(dx.head<3>()) * T;
+    xi += dx.tail<3>();
+    if (it >= 3 && dx.head<2>().norm() < 1e-5 && std::abs(dx(2)) < 1e-7) break;
+  }
+  last_inliers_ = cnt;
+  const double dof = std::max(1.0, 2.0 * cnt - 6.0);
+  cov = A.inverse() * std::max(1.0, chi2 / dof);
+  return cov.allFinite() && T.allFinite() && xi.allFinite();
+}
+
+void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_prev,
+                            const Eigen::Matrix3d& P_prev, double nndr, MotionEstimate& pair,
+                            Eigen::Matrix3d& T_w, Eigen::Matrix3d& P) {
+  const double dt = has_last_stamp_ ? 1e-9 * static_cast<double>(cur.stamp_ns - last_stamp_) : 0.25;
+  last_stamp_ = cur.stamp_ns;
+  has_last_stamp_ = true;
+  if (!has_key_) {
+    compound(T_w_prev, P_prev, pair.T_12, pair.T_12_cov, T_w, P);
+    makeKeyframe(cur, pair.velocity, T_w, P);
+    return;
+  }
+  // The pair step assumes a smooth velocity; its covariance does not know that the yaw rate
+  // can step (turn entry and exit: measured 1-2 deg errors of that step). Inflate it by
+  // white-noise acceleration over the step so the registration can overrule it there.
+  const double ql = 0.5 * kStepAccelSigma * dt * dt, qa = 0.5 * kStepAngAccelSigma * dt * dt;
+  Eigen::Matrix3d C_12 = pair.T_12_cov;
+  C_12.diagonal() += Eigen::Vector3d(ql * ql, ql * ql, qa * qa);
+  Eigen::Matrix3d T_odo, C_odo;
+  compound(T_jprev_, C_jprev_, pair.T_12, C_12, T_odo, C_odo);
+  Eigen::Matrix3d T_jk = T_odo, C_jk = C_odo;
+  const bool still = pair.velocity.isZero();
+  if (still) has_prev_pair_ = false;
+  bool registered = false;
+  last_inliers_ = 0;
+  if (still) {
+    // Standing still (the refined estimator snapped the velocity to zero): hold the pose.
+    T_jk = T_jprev_;
+    C_jk = C_jprev_;
+  } else {
+    matchDescriptors(key_desc_, cur.descriptors, nndr, matches_);
+    qx_.clear(); qy_.clear(); px_.clear(); py_.clear(); ux_.clear(); uy_.clear(); tau_.clear();
+    for (const Match& m : matches_) {
+      const Keypoint& k = cur.keypoints[m.i2];
+      qx_.push_back(key_pts_[m.i1].x());
+      qy_.push_back(key_pts_[m.i1].y());
+      px_.push_back(k.x);
+      py_.push_back(k.y);
+      ux_.push_back(std::cos(k.azimuth));
+      uy_.push_back(-std::sin(k.azimuth));
+      tau_.push_back(1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns));
+    }
+    // The pair velocity is centred about half a scan before scan k's own; within a scan the
+    // yaw rate is only weakly observable (it trades against the yaw), so this prior has to
+    // stay tight: inflated for a tenth of a scan (kPriorLag), not half.
+    const double dl = kAccelSigma * kPriorLag * dt, da = kAngAccelSigma * kPriorLag * dt;
+    // Extrapolated by half a scan from the previous pair (linear in time): with the yaw
+    // rate changing every scan, the lagged pair velocity left a ~0.2 deg yaw bias.
+    Eigen::Vector3d xi_prior = pair.velocity;
+    Eigen::Matrix3d Cxi = pair.velocity_cov;
+    if (has_prev_pair_) {
+      xi_prior += 0.5 * (pair.velocity - prev_pair_xi_);
+      Cxi = 2.25 * pair.velocity_cov + 0.25 * prev_pair_cov_;
+    }
+    prev_pair_xi_ = pair.velocity;
+    prev_pair_cov_ = pair.velocity_cov;
+    has_prev_pair_ = true;
+    Cxi.diagonal() += Eigen::Vector3d(dl * dl, dl * dl, da * da);
+    Eigen::Vector3d xi = xi_prior;
+    Eigen::Matrix<double, 6, 6> cov;
+    Eigen::Matrix3d T = T_odo;
+    registered = solve(T_odo, C_odo, xi_prior, Cxi, T, xi, cov);
+    if (registered) {
+      T_jk = T;
+      const Eigen::Matrix3d L = se2::leftPerturbationToXyYaw(T);
+      C_jk = L * cov.topLeftCorner<3, 3>() * L.transpose();
+      pair.velocity = xi;
+      pair.velocity_cov = cov.bottomRightCorner<3, 3>();
+    }
+  }
+  compound(T_wj_, P_j_, T_jk, C_jk, T_w, P);
+  pair.T_12 = se2::inverse(T_w_prev) * T_w;
+  if (registered && key_inliers_ == 0) key_inliers_ = last_inliers_;
+  const double dist = T_jk.topRightCorner<2, 1>().norm();
+  const double ang = std::abs(std::atan2(T_jk(1, 0), T_jk(0, 0)));
+  const bool renew = (!still && !registered) || dist > kKeyframeDistance || ang > kKeyframeAngle ||
+                     (registered && last_inliers_ < kInlierRatio * key_inliers_);
+  if (renew) {
+    makeKeyframe(cur, pair.velocity, T_w, P);
+  } else {
+    T_jprev_ = T_jk;
+    C_jprev_ = C_jk;
+  }
+}
+
+}  // namespace spinradar
