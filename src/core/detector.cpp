@@ -164,6 +164,46 @@ void Detector::detect(const PolarScan& scan, std::vector<Keypoint>& out) {
     detectCfar(scan, out);
   else
     detectCen2018(scan, out);
+  if (azimuth_peaks_) keepAzimuthPeaks(scan, out);
+}
+
+void Detector::keepAzimuthPeaks(const PolarScan& scan, std::vector<Keypoint>& out) const {
+  // A return shows in every row whose beam covers it (about +-2 rows), and each row's
+  // keypoint sits on the row's angle, not on the target: keep the row where the peak power
+  // (within +-2 bins) is highest across rows and move it to the parabola vertex through the
+  // neighbouring rows (dB power ~ parabolic beam), its time with it.
+  const int N = scan.azimuths;
+  if (N < 3 || out.empty()) return;
+  const double step = 2.0 * M_PI / N;
+  const double row_dt = double(scan.stamp_ns.back() - scan.stamp_ns.front()) / (N - 1);
+  auto peakPower = [&](int a, int b) {
+    a = (a % N + N) % N;
+    if (!scan.valid.empty() && !scan.valid[a]) return -1;
+    const uint8_t* row = scan.row(a);
+    int m = 0;
+    for (int j = std::max(0, b - 2); j <= std::min(scan.bins - 1, b + 2); ++j) m = std::max<int>(m, row[j]);
+    return m;
+  };
+  size_t w = 0;
+  for (size_t i = 0; i < out.size(); ++i) {
+    Keypoint k = out[i];
+    const int a = k.azimuth_index, b = int(std::lround(k.bin));
+    const int pm = peakPower(a - 1, b), p0 = peakPower(a, b), pp = peakPower(a + 1, b);
+    // Not an azimuthal peak: drop it (a plateau, e.g. saturation, keeps its first row).
+    if (p0 < pm || p0 < pp || (p0 == pm && p0 == pp) || (p0 == pm && p0 > pp)) continue;
+    double d = 0.0;
+    if (pm >= 0 && pp >= 0) {
+      const double den = pm - 2.0 * p0 + pp;
+      d = den < 0 ? std::clamp(0.5 * (pm - pp) / den, -0.5, 0.5) : 0.0;
+      if (p0 == pp) d = 0.5;  // plateau of two rows: between them
+    }
+    k.azimuth = scan.azimuth[a] + d * step;
+    k.x = k.range * std::cos(k.azimuth);
+    k.y = -k.range * std::sin(k.azimuth);
+    k.stamp_ns += std::llround(d * row_dt);
+    out[w++] = k;
+  }
+  out.resize(w);
 }
 
 void Detector::rangeWindow(const PolarScan& scan, int& b0, int& b1) const {

@@ -65,4 +65,6 @@ void FeatureExtractor::extract(const PolarScan& scan, FeatureFrame& out, StageTi
 
 const cv::Mat& FeatureExtractor::cartesianImage() const { return impl_->cart; }
 
+void FeatureExtractor::setAzimuthPeaks(bool on) { impl_->detector.setAzimuthPeaks(on); }
+
 }  // namespace spinradar

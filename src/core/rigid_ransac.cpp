@@ -6,6 +6,7 @@
 #include <Eigen/LU>
 
 #include "spinradar/core/lie.hpp"
+#include "spinradar/core/mc_ransac.hpp"
 
 namespace spinradar {
 
@@ -39,13 +40,14 @@ bool fitRigid2d(const Eigen::Vector2d* a, const Eigen::Vector2d* b, const int* i
 RigidRansac::RigidRansac(const EstimatorConfig& config) : config_(config) {}
 
 int RigidRansac::countInliers(const Eigen::Matrix3d& T, std::vector<int>* inliers) const {
-  const double thr2 = config_.inlier_threshold * config_.inlier_threshold;
+  // The gate of MC-RANSAC (one azimuth row of tangential slack, see McRansac::kAzimuthQuantum).
+  const double thr = config_.inlier_threshold, sa = config_.azimuth_sigma;
   const Eigen::Matrix2d C = T.topLeftCorner<2, 2>();
   const Eigen::Vector2d r = T.topRightCorner<2, 1>();
   int n = 0;
   if (inliers) inliers->clear();
   for (size_t i = 0; i < p1_.size(); ++i) {
-    if ((p1_[i] - C * p2_[i] - r).squaredNorm() < thr2) {
+    if (withinInlierGate(p1_[i] - C * p2_[i] - r, p1_[i], thr, sa)) {
       ++n;
       if (inliers) inliers->push_back(static_cast<int>(i));
     }

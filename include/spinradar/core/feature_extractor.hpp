@@ -27,6 +27,10 @@ class FeatureExtractor {
   /// sensor at the centre, x forward = up, y left = left). For debug display.
   const cv::Mat& cartesianImage() const;
 
+  /// Keypoints at azimuthal peaks with sub-row azimuths (Detector::setAzimuthPeaks); off by
+  /// default. Not yet a DetectorConfig parameter.
+  void setAzimuthPeaks(bool on);
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
