@@ -85,8 +85,23 @@ DiagnoseReport diagnoseRecording(const DiagnoseInput& in, const DiagnoseOptions&
   const double sweep = timing.period_mean > 0 ? timing.period_mean : 1.0 / in.sensor.rotation_hz;
   const double tau_fixed =
       in.base.motion_distortion ? -1.0 : opt.conventions.instant_fraction * sweep;
-  analyseJitter(rep.obs, rep.scans, rep.sigma_r, rep.sigma_az, tau_fixed,
-                !with_world || opt.target_nuisance, timing, opt.timing_options);
+  // Residuals for the jitter fit: real minus re-simulated with the kept catalogue effects
+  // (exact, so peak-interpolation biases cancel as in the catalogue stage); the linear fit's
+  // residuals only when nothing was re-simulated. Returns the re-simulation lost are left out.
+  std::vector<Observation> jobs;
+  const bool resim = !rep.after_e_r.empty();
+  for (size_t i = 0; i < rep.obs.size(); ++i) {
+    Observation o = rep.obs[i];
+    if (resim) {
+      o.fit_r = rep.after_e_r.back()[i];
+      o.fit_az = rep.after_e_az.back()[i];
+      if (!std::isfinite(o.fit_r) || !std::isfinite(o.fit_az)) continue;
+    }
+    jobs.push_back(o);
+  }
+  analyseJitter(jobs, rep.scans, rep.sigma_r, rep.sigma_az,
+                detail::rangeNoiseFloor(in.sensor), detail::azimuthNoiseFloor(in.sensor),
+                tau_fixed, !with_world || opt.target_nuisance, timing, opt.timing_options);
   double offset = 0, offset_sd = 0;
   for (const auto& e : rep.effects)
     if (e.effect == Effect::TimestampOffset) {

@@ -212,25 +212,32 @@ TimingReport analyseStamps(const std::vector<PolarScan>& scans, double rotation_
       t.burst_z = z;
       t.burst_p = p;
       t.burst_gap = m1;
-      if (z > 0 && p < opt.alpha && m1 - m0 > opt.min_burst_step) {
+      // Packet sizes seen: runs between steps above the midpoint of the two means.
+      const double cut = 0.5 * (m0 + m1);
+      int runs = 0, exact = 0;
+      for (const auto& s : steps) {
+        int last = -1;
+        for (const Step& x : s)
+          if (x.d > cut) {
+            if (last >= 0) {
+              ++runs;
+              exact += (x.next - last == best_b);
+            }
+            last = x.next;
+          }
+      }
+      const double agreement = runs > 0 ? static_cast<double>(exact) / runs : 0;
+      // The search takes the best of many (size, phase) choices per scan, so noisy uniform
+      // stamps reach |z| ~ 5 by chance (2 of 20 at 30 us noise before these checks): also
+      // require a gap step of at least a tenth of the mean row interval and that most packets
+      // seen between two gaps have the fitted size (noise gives random run lengths).
+      const double mean_step = (s1 + s0) / (n1 + n0);
+      if (z > 0 && p < opt.alpha && m1 - m0 > std::max(opt.min_burst_step, 0.1 * mean_step) &&
+          agreement >= 0.5) {
         t.bursts = true;
         t.burst_size = best_b;
         t.burst_phase = phase;
-        // Packet sizes seen: runs between steps above the midpoint of the two means.
-        const double cut = 0.5 * (m0 + m1);
-        int runs = 0, exact = 0;
-        for (const auto& s : steps) {
-          int last = -1;
-          for (const Step& x : s)
-            if (x.d > cut) {
-              if (last >= 0) {
-                ++runs;
-                exact += (x.next - last == best_b);
-              }
-              last = x.next;
-            }
-        }
-        t.burst_size_agreement = runs > 0 ? static_cast<double>(exact) / runs : 0;
+        t.burst_size_agreement = agreement;
       }
     }
   }

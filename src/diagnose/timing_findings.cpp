@@ -84,8 +84,8 @@ void addStampFindings(TimingReport& t, const TimingOptions& opt) {
 }  // namespace detail
 
 void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_r,
-                   double sigma_az, double tau_fixed, bool target_nuisance, TimingReport& t,
-                   const TimingOptions& opt) {
+                   double sigma_az, double floor_r, double floor_az, double tau_fixed,
+                   bool target_nuisance, TimingReport& t, const TimingOptions& opt) {
   const int to = static_cast<int>(Effect::TimestampOffset);
   if (sigma_r <= 0 || sigma_az <= 0 || scans < 2) return;
   // Scans with enough returns and a usable regressor.
@@ -124,13 +124,14 @@ void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_
   std::vector<bool> keep(rows.size(), true);
   double sr = sigma_r, sa = sigma_az;
   OlsFit fit;
+  Eigen::MatrixXd X;
   std::vector<int> idx;
   for (int pass = 0; pass < 3; ++pass) {
     idx.clear();
     for (size_t i = 0; i < rows.size(); ++i)
       if (keep[i]) idx.push_back(static_cast<int>(i));
     const int m = static_cast<int>(idx.size());
-    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(2 * m, n_nuis + K);
+    X = Eigen::MatrixXd::Zero(2 * m, n_nuis + K);
     Eigen::VectorXd y(2 * m);
     for (int j = 0; j < m; ++j) {
       const Observation& o = *rows[idx[j]];
@@ -152,7 +153,10 @@ void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_
       rr.push_back(fit.resid(j) * sr);
       ra.push_back(fit.resid(m + j) * sa);
     }
-    const double nsr = std::max(robustSigma(rr), 1e-6), nsa = std::max(robustSigma(ra), 1e-7);
+    // Floored like the catalogue's scales: a mostly exact simulation has MAD 0, and without
+    // the floor every non-zero residual would be cut as an outlier.
+    const double nsr = std::max(robustSigma(rr), floor_r);
+    const double nsa = std::max(robustSigma(ra), floor_az);
     for (int j = 0; j < m; ++j)
       keep[idx[j]] = std::fabs(rr[j]) < opt.outlier_sigma * nsr &&
                      std::fabs(ra[j]) < opt.outlier_sigma * nsa;
@@ -165,9 +169,14 @@ void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_
   Eigen::VectorXd e(K);
   Eigen::MatrixXd cov(K, K);
   double vbar = 0, mean = 0;
+  // Noise variance at least 1 in whitened units (the scales' floors are the precision a peak
+  // fit can claim), so an exact fit does not make tiny differences infinitely significant.
+  const Eigen::MatrixXd inv =
+      (X.transpose() * X).completeOrthogonalDecomposition().pseudoInverse();
+  const double s2_eff = std::max(fit.sigma2, 1.0);
   for (int a = 0; a < K; ++a) {
     e(a) = fit.coef(n_nuis + a);
-    for (int b = 0; b < K; ++b) cov(a, b) = fit.cov(n_nuis + a, n_nuis + b);
+    for (int b = 0; b < K; ++b) cov(a, b) = s2_eff * inv(n_nuis + a, n_nuis + b);
     t.stretch[used[a]] = e(a);
     t.stretch_sd[used[a]] = std::sqrt(std::max(cov(a, a), 0.0));
     vbar += cov(a, a) / K;
