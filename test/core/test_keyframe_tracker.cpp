@@ -45,6 +45,7 @@ using Hook = std::function<void(SyntheticScene&, int k, FeatureFrame&, const std
 Drive run(const std::string& estimator, SyntheticScene& scene, int scans, const Hook& hook = {}) {
   PipelineConfig cfg;
   cfg.estimator.estimator = estimator;
+  cfg.estimator.beta = scene.options().beta;
   Odometry odo(cfg);
   Drive d;
   Eigen::Matrix3d prev_truth = Eigen::Matrix3d::Identity(), prev_est = prev_truth;
@@ -78,11 +79,15 @@ Drive run(const std::string& estimator, SyntheticScene& scene, int scans, const 
   return d;
 }
 
-/// Speed 8-12 m/s and yaw rate swinging +-15 deg/s, changing every scan.
-std::vector<Eigen::Vector3d> varyingProfile(int n) {
+/// Speed 8-12 m/s and yaw rate swinging +-15 deg/s, changing every scan after the first
+/// two (the very first pair has no previous one to take out its half-scan lag: a start-up
+/// error of ~0.26 deg there that every estimator keeps).
+std::vector<Eigen::Vector3d> varyingProfile(int n, double phase = 0.0) {
   std::vector<Eigen::Vector3d> v;
-  for (int k = 0; k < n + 1; ++k)
-    v.emplace_back(10.0 + 2.0 * std::sin(0.2 * k), 0.0, 15.0 * kDeg * std::sin(0.15 * k));
+  for (int k = 0; k < n + 1; ++k) {
+    const double t = std::max(k, 1) + phase;
+    v.emplace_back(10.0 + 2.0 * std::sin(0.2 * t), 0.0, 15.0 * kDeg * std::sin(0.15 * t));
+  }
   return v;
 }
 
@@ -165,7 +170,7 @@ TEST(KeyframeTracker, PoseCovarianceIsHonest) {
   const int n = 16, seeds = 8;
   double nees = 0.0;
   for (uint32_t seed = 1; seed <= seeds; ++seed) {
-    SyntheticScene scene(options(100 + seed), varyingProfile(n));
+    SyntheticScene scene(options(100 + seed), varyingProfile(n, 3.0 * seed));
     nees += run("keyframe", scene, n).nees / seeds;
   }
   std::cout << "[ info ] keyframe mean NEES of the final pose over " << seeds << " drives: "

@@ -40,7 +40,7 @@ class KeyframeTracker {
  public:
   explicit KeyframeTracker(const EstimatorConfig& config = EstimatorConfig{});
   void setConfig(const EstimatorConfig& config) { config_ = config; }
-  void reset() { has_key_ = has_last_stamp_ = has_prev_pair_ = false; }
+  void reset() { has_key_ = has_last_stamp_ = false; }
 
   /// cur: the newest scan (raw keypoints and descriptors). pair: the frame-to-frame estimate
   /// from the previous scan to cur (ok), updated in place (velocity, velocity_cov, T_12).
@@ -79,9 +79,6 @@ class KeyframeTracker {
   bool has_key_ = false;
   int64_t last_stamp_ = 0;  ///< previous scan's stamp (for the prior's lag inflation)
   bool has_last_stamp_ = false;
-  bool has_prev_pair_ = false;  ///< previous scan's pair velocity (for the extrapolation)
-  Eigen::Vector3d prev_pair_xi_ = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d prev_pair_cov_ = Eigen::Matrix3d::Zero();
   int switches_ = 0;
   int last_inliers_ = 0;
   int key_inliers_ = 0;  ///< inliers of the first registration to this keyframe (0 = none yet)
