@@ -191,4 +191,8 @@ TEST(Odometry, ConfigIsValidatedAndApplied) {
   cfg.estimator.estimator = "rigid";
   odo.setConfig(cfg);
   EXPECT_EQ(odo.config().estimator.estimator, "rigid");
+  for (const char* e : {"mc", "mc_doppler", "refined", "keyframe"}) {
+    cfg.estimator.estimator = e;
+    EXPECT_NO_THROW(odo.setConfig(cfg)) << e;
+  }
 }
