@@ -38,7 +38,16 @@ KeyframeTracker::KeyframeTracker(const EstimatorConfig& config) : config_(config
 void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d& xi,
                                    const Eigen::Matrix3d& T_w, const Eigen::Matrix3d& P) {
   // The keyframe's points as a static map: Doppler-corrected and moved to its reference
-  // time with its own velocity.
+  // time with its own velocity. Headroom so that later keyframes rarely reallocate.
+  const size_t n = f.keypoints.size();
+  if (tmp_kps_.capacity() < n) tmp_kps_.reserve(n + n / 2);
+  if (key_pts_.capacity() < n) key_pts_.reserve(n + n / 2);
+  if (matches_.capacity() < n) {  // at most one match per keyframe row
+    const size_t c = n + n / 2;
+    matches_.reserve(c);
+    for (auto* v : {&qx_, &qy_, &px_, &py_, &ux_, &uy_, &tau_}) v->reserve(c);
+    in_.reserve(c);
+  }
   dopplerCorrect(f.keypoints, xi, config_.beta, tmp_kps_);
   undistortPoints(tmp_kps_, xi, f.stamp_ns, key_pts_);
   const cv::Mat& d = f.descriptors;
