@@ -2,7 +2,8 @@
 # The paper's experiments (Burnett et al. 2021) on simulated drives, in one command:
 #   Table I  - radar odometry with rigid RANSAC, MC-RANSAC and MC-RANSAC + Doppler over the
 #              simulator's built-in city route with full physics (motion distortion, Doppler
-#              beta = 0.049 s, moving objects), KITTI-style drift (100..800 m subsequences).
+#              beta = 0.049 s, moving objects), KITTI-style drift (100..800 m subsequences);
+#              plus this package's keyframe estimator (issue 9) as an extra row.
 #   Table II - metric localization against a drive in the opposite direction: provided by the
 #              localization issue through `spinradar localize`; printed here once it exists.
 # Usage: scripts/paper_experiments.sh [OUT_DIR]   (default build/paper_experiments)
@@ -49,8 +50,7 @@ else
 fi
 
 # --- Table I: odometry with each estimator ---
-labels=(rigid mc mc_doppler)
-names=("Rigid RANSAC" "MC-RANSAC" "MC-RANSAC + Doppler")
+labels=(rigid mc mc_doppler keyframe)
 est_args=()
 for est in "${labels[@]}"; do
   echo "== odometry, estimator $est" >&2
@@ -62,11 +62,12 @@ echo "== evaluation" >&2
 "$bin" eval "${est_args[@]}" --gt "$rec/trajectory.csv" --step "$step" \
   --plot "$out/odometry.png" --json "$out/odometry.json" > "$out/odometry_eval.txt"
 
-/usr/bin/env python3 - "$out/odometry.json" "$scene" <<'PY'
-import json, sys
+/usr/bin/env python3 - "$out/odometry.json" "$scene" "$out" <<'PY'
+import json, os, re, sys
 rows = {r["label"]: r for r in json.load(open(sys.argv[1]))}
 paper = {"rigid": (3.9777, 0.0141), "mc": (3.6042, 0.0119), "mc_doppler": (3.5847, 0.0118)}
-names = {"rigid": "Rigid RANSAC", "mc": "MC-RANSAC", "mc_doppler": "MC-RANSAC + Doppler"}
+names = {"rigid": "Rigid RANSAC", "mc": "MC-RANSAC", "mc_doppler": "MC-RANSAC + Doppler",
+         "keyframe": "keyframe (this package, not in the paper)"}
 r0 = rows["rigid"]
 print()
 print(f"Table I (simulated '{sys.argv[2]}' route, full physics: {r0['path_length_m']:.0f} m, "
@@ -74,13 +75,26 @@ print(f"Table I (simulated '{sys.argv[2]}' route, full physics: {r0['path_length
 print()
 print("| Method | Translational Error (%) | Rotational Error (deg/m) | paper (Oxford): % | deg/m |")
 print("|---|---|---|---|---|")
-for k in ("rigid", "mc", "mc_doppler"):
+for k in ("rigid", "mc", "mc_doppler", "keyframe"):
     r = rows[k]
     if r["drift_valid"]:
         t, a = f"{r['t_err_pct']:.4f}", f"{r['r_err_deg_per_m']:.4f}"
     else:
         t, a = "n/a (< 100 m)", "n/a"
-    print(f"| {names[k]} | {t} | {a} | {paper[k][0]:.4f} | {paper[k][1]:.4f} |")
+    pt, pa = (f"{paper[k][0]:.4f}", f"{paper[k][1]:.4f}") if k in paper else ("-", "-")
+    print(f"| {names[k]} | {t} | {a} | {pt} | {pa} |")
+def ms_per_scan(k):
+    """Mean pipeline ms per scan from the odometry log (CPU time of the chain, not wall)."""
+    try:
+        for line in open(os.path.join(sys.argv[3], f"odometry_{k}.log")):
+            m = re.match(r"\s*pipeline total\s+\S+ s\s+(\S+) ms", line)
+            if m:
+                return m.group(1)
+    except OSError:
+        pass
+    return "?"
+print()
+print("ms per scan (detector to estimate): " + ", ".join(f"{k} {ms_per_scan(k)}" for k in names))
 if all(rows[k]["drift_valid"] for k in paper):
     rt, mt, dt = (rows[k]["t_err_pct"] for k in ("rigid", "mc", "mc_doppler"))
     rr, mr, dr = (rows[k]["r_err_deg_per_m"] for k in ("rigid", "mc", "mc_doppler"))
