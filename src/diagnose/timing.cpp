@@ -328,7 +328,8 @@ TimingReport analyseStamps(const std::vector<PolarScan>& scans, double rotation_
     t.period_mean = t.period.front();
   }
   if (rotation_hz > 0)
-    t.notes.push_back("Nominal period " + std::to_string(1e3 / rotation_hz) + " ms (sensor).");
+    t.notes.push_back("Nominal period " + std::to_string(std::lround(1e6 / rotation_hz)) +
+                      " us (sensor configuration).");
   detail::addStampFindings(t, opt);
   return t;
 }
