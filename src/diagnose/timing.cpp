@@ -301,7 +301,8 @@ TimingReport analyseStamps(const std::vector<PolarScan>& scans, double rotation_
     t.start_gap.push_back(c1 - c0);
   }
   // 3. Does the period vary from scan to scan? Weighted equality test and the spread.
-  if (K >= 2) {
+  // Stamps that do not advance (all zero, or made up per scan) carry no period information.
+  if (K >= 2 && t.row_interval > 0) {
     double sw = 0, swx = 0, mean = 0, vbar = 0;
     for (int k = 0; k < K; ++k) {
       const double w = 1.0 / std::max(t.period_sd[k] * t.period_sd[k], 1e-30);

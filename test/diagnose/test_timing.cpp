@@ -125,6 +125,14 @@ TEST(TimingStamps, NoisyUniformStampsGiveNoFinding) {
   }
 }
 
+TEST(TimingStamps, StampsThatDoNotAdvanceGiveNoFinding) {
+  auto scans = stampsOnly(kNone, 3, 10);
+  for (auto& s : scans) std::fill(s.stamp_ns.begin(), s.stamp_ns.end(), 0);
+  const TimingReport t = analyseStamps(scans, 4.0);
+  EXPECT_TRUE(t.findings.empty());
+  EXPECT_FALSE(std::isnan(t.period_rel_std));
+}
+
 // ---- with a world file: the catalogue stage runs on the corrected stamps ----
 
 DiagnoseReport withWorld(const nlohmann::json& hidden, const nlohmann::json& base, int n,
