@@ -117,7 +117,9 @@ void run(const DiagnoseArgs& a) {
     return;
   }
   diagnose::writeReport(rep, a.out);
-  std::cout << (rep.mismatch_found ? "mismatch found:" : "no significant mismatch");
+  std::cout << (!rep.mismatch_found        ? "no significant mismatch"
+                : rep.effects.empty()         ? "mismatch found (timing only, below)"
+                                              : "mismatch found:");
   for (const auto& e : rep.effects)
     std::cout << " " << e.name << " = " << e.value << " +- " << e.stddev << " " << e.unit
               << " (z " << e.significance << ")";
