@@ -123,6 +123,45 @@ void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_
     if (o.scan >= 0 && o.scan < scans && col[o.scan] >= 0) rows.push_back(&o);
   std::vector<bool> keep(rows.size(), true);
   double sr = sigma_r, sa = sigma_az;
+  {
+    // Robust start: per scan, the x^2-weighted median of y / x over both residual components.
+    // Scale and outliers from a plain first fit fail when most scans are clean: the robust
+    // scale collapses to the floor, and a few jumped peaks drag the fit, so the returns of the
+    // jittered scans would all be cut as outliers.
+    std::vector<std::vector<std::pair<double, double>>> ratio(K);
+    auto add = [&](int k, double x, double y) {
+      if (std::fabs(x) > 1e-12) ratio[k].push_back({y / x, x * x});
+    };
+    for (const Observation* o : rows) {
+      const double tau = tau_fixed < 0 ? o->tau : tau_fixed;
+      add(col[o->scan], -tau * o->dr[to] / sigma_r, o->fit_r / sigma_r);
+      add(col[o->scan], -tau * o->daz[to] / sigma_az, o->fit_az / sigma_az);
+    }
+    std::vector<double> e0(K, 0.0);
+    for (int k = 0; k < K; ++k) {
+      auto& v = ratio[k];
+      std::sort(v.begin(), v.end());
+      double total = 0, acc = 0;
+      for (const auto& p : v) total += p.second;
+      for (const auto& p : v) {
+        acc += p.second;
+        if (acc >= 0.5 * total) {
+          e0[k] = p.first;
+          break;
+        }
+      }
+    }
+    std::vector<double> rr, ra;
+    for (const Observation* o : rows) {
+      const double tau = tau_fixed < 0 ? o->tau : tau_fixed;
+      rr.push_back(o->fit_r + e0[col[o->scan]] * tau * o->dr[to]);
+      ra.push_back(o->fit_az + e0[col[o->scan]] * tau * o->daz[to]);
+    }
+    sr = std::max(robustSigma(rr), floor_r);
+    sa = std::max(robustSigma(ra), floor_az);
+    for (size_t i = 0; i < rows.size(); ++i)
+      keep[i] = std::fabs(rr[i]) < opt.outlier_sigma * sr && std::fabs(ra[i]) < opt.outlier_sigma * sa;
+  }
   OlsFit fit;
   Eigen::MatrixXd X;
   std::vector<int> idx;
