@@ -227,9 +227,26 @@ void nameAndFitEffects(const DiagnoseInput& in, const DiagnoseOptions& opt,
     if (pass == 1) break;
     sr = noiseScale(rr, floor_r);
     sa = noiseScale(ra, floor_a);
-    for (auto& o : rep.obs)
+    // Without a world file a mapped "target" can be a scatterer that is not a point (wall
+    // speckle, a moving object): its GLS-whitened residuals after the fit are jointly far
+    // beyond their chi-square; all of its views are dropped.
+    std::map<int, std::pair<double, int>> chi;
+    if (map) {
+      const int m = static_cast<int>(d.rows.size());
+      const double s2 = std::max(sel.joint.sigma2, 1e-300);
+      for (int j = 0; j < m; ++j) {
+        auto& c = chi[rep.obs[d.rows[j]].target];
+        c.first += (sel.joint.resid(j) * sel.joint.resid(j) +
+                    sel.joint.resid(m + j) * sel.joint.resid(m + j)) / s2;
+        c.second += 2;
+      }
+    }
+    for (auto& o : rep.obs) {
       o.inlier = std::fabs(o.fit_r) < opt.outlier_sigma * sr &&
                  std::fabs(o.fit_az) < opt.outlier_sigma * sa;
+      const auto it = chi.find(o.target);
+      if (it != chi.end() && chi2Sf(it->second.first, it->second.second) < 1e-6) o.inlier = false;
+    }
   }
   rep.sigma_r = sr;
   rep.sigma_az = sa;

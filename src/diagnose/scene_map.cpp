@@ -107,6 +107,7 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
 
   std::unordered_map<int64_t, std::vector<int>> grid;
   std::vector<Cluster> clusters;
+  std::vector<std::vector<MapPeak>> scan_peaks(n);  // every peak of each map scan
   const double cell = opt.cluster_radius;
   for (int k : m.map_scans) {
     const PolarScan& s = scans[k];
@@ -134,6 +135,7 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
         pk.first_stamp = geo.firstStamp();
         pk.sweep = geo.sweep;
         pk.power = v;
+        scan_peaks[k].push_back(pk);
         const Eigen::Vector2d wp = placePeak(pk, traj, cph);
         const double wx = wp.x(), wy = wp.y();
         ++m.peaks;
@@ -184,6 +186,24 @@ SceneMap buildSceneMap(const std::vector<PolarScan>& scans, const sim::Trajector
       else if (pk.power > it->power)
         *it = pk;
     }
+    // A point target must dominate its surroundings (as the association requires): in most
+    // of its scans no other peak within the window is less than dominance_db weaker. Wall and
+    // vegetation speckle fails this and would make the association jump between scatterers.
+    int crowded = 0;
+    for (const MapPeak& pk : kept) {
+      for (const MapPeak& q : scan_peaks[pk.scan]) {
+        const double dr = std::fabs(q.range - pk.range);
+        const double da = std::fabs(std::remainder(q.azimuth - pk.azimuth, 2 * M_PI));
+        // Other local maxima inside the point spread are the same return.
+        if (dr < opt.spread_range && da < opt.spread_azimuth) continue;
+        if (dr < opt.isolation_range && da < opt.isolation_azimuth &&
+            q.power > pk.power - opt.dominance_db * sensor.power_scale) {
+          ++crowded;
+          break;
+        }
+      }
+    }
+    if (crowded > opt.max_crowded_fraction * kept.size()) continue;
     sim::Target t;
     double sdb = 0;
     for (const MapPeak& pk : kept) {

@@ -1,8 +1,9 @@
 // Issue 10: diagnosis without a world file. The scene is mapped from one part of the recording
 // (map-aware regressors: the mapped positions move with each effect), the rest is diagnosed;
 // the split is chosen by --map-split auto. Every catalogue effect is hidden in turn and must be
-// named (alone) and fitted within 15 %, with the re-simulated residual lower after the fit;
-// drives recorded with the base model must come out clean.
+// named first and fitted within 15 %, with the re-simulated residual lower after the fit (any
+// further effect only a small remainder); drives recorded with the base model must come out
+// clean.
 #include <cmath>
 #include <iostream>
 
@@ -74,10 +75,17 @@ TEST_P(NoWorld, NamesAndFitsTheHiddenEffect) {
     return;
   }
   ASSERT_TRUE(rep.mismatch_found);
-  EXPECT_EQ(rep.effects.size(), 1u);
-  EXPECT_EQ(rep.effects.front().name, c.expect);
-  EXPECT_NEAR(rep.effects.front().value, c.value, 0.15 * std::fabs(c.value));
+  const EffectResult& first = rep.effects.front();
+  EXPECT_EQ(first.name, c.expect);
+  EXPECT_NEAR(first.value, c.value, 0.15 * std::fabs(c.value));
   EXPECT_LT(rep.after.position_rms, rep.before.position_rms);
+  // A second effect may only be a small linearisation remainder of a large first one: its
+  // re-simulated residual drop must be under 5 % of the first's.
+  const double first_drop = first.residual_rms_before - first.residual_rms_after;
+  for (size_t i = 1; i < rep.effects.size(); ++i)
+    EXPECT_LT(rep.effects[i].residual_rms_before - rep.effects[i].residual_rms_after,
+              0.05 * first_drop)
+        << rep.effects[i].name;
 }
 
 // clang-format off

@@ -23,6 +23,15 @@ struct SceneMapOptions {
   double cluster_radius = 1.0;  ///< m (wide: a wrong physics scatters a target's placements)
   double min_fraction = 0.5;    ///< of the map scans a location must be seen in
   double min_range = 4.0;       ///< m
+  /// Isolation: another peak of the same scan within this window and less than dominance_db
+  /// weaker makes the target's peak crowded; targets crowded in more than
+  /// max_crowded_fraction of their scans are not mapped.
+  double isolation_range = 2.0;      ///< m
+  double isolation_azimuth = 0.1;    ///< rad
+  double spread_range = 0.3;         ///< m: peaks closer than this and
+  double spread_azimuth = 0.04;      ///< rad: this are the same return (point spread)
+  double dominance_db = 8.0;
+  double max_crowded_fraction = 0.25;
 };
 
 /// One peak of a map scan as recorded (reported range and azimuth, recorded stamps).
