@@ -172,6 +172,7 @@ void Detector::keepAzimuthPeaks(const PolarScan& scan, std::vector<Keypoint>& ou
   // keypoint sits on the row's angle, not on the target: keep the row where the peak power
   // (within +-2 bins) is highest across rows and move it to the parabola vertex through the
   // neighbouring rows (dB power ~ parabolic beam), its time with it.
+  constexpr int kMaxPlateauRows = 16;
   const int N = scan.azimuths;
   if (N < 3 || out.empty()) return;
   const double step = 2.0 * M_PI / N;
@@ -189,15 +190,20 @@ void Detector::keepAzimuthPeaks(const PolarScan& scan, std::vector<Keypoint>& ou
     Keypoint k = out[i];
     const int a = k.azimuth_index, b = int(std::lround(k.bin));
     const int pm = peakPower(a - 1, b), p0 = peakPower(a, b), pp = peakPower(a + 1, b);
-    // Not an azimuthal peak: drop it (a plateau, e.g. saturation, keeps its first row).
-    if (p0 < pm || p0 < pp || (p0 == pm && p0 == pp) || (p0 == pm && p0 > pp)) continue;
+    // Not an azimuthal peak: drop it. A plateau (saturation) is kept once, at its first row,
+    // and moved to its centre.
+    if (p0 < pm || p0 < pp || p0 == pm) continue;
     double d = 0.0;
-    if (pm >= 0 && pp >= 0) {
+    if (p0 == pp) {
+      int len = 2;
+      while (len < kMaxPlateauRows && peakPower(a + len, b) == p0) ++len;
+      d = 0.5 * (len - 1);
+    } else if (pm >= 0 && pp >= 0) {
       const double den = pm - 2.0 * p0 + pp;
-      d = den < 0 ? std::clamp(0.5 * (pm - pp) / den, -0.5, 0.5) : 0.0;
-      if (p0 == pp) d = 0.5;  // plateau of two rows: between them
+      d = std::clamp(0.5 * (pm - pp) / den, -0.5, 0.5);  // den < 0: p0 > pm, p0 > pp
     }
     k.azimuth = scan.azimuth[a] + d * step;
+    if (k.azimuth >= 2.0 * M_PI) k.azimuth -= 2.0 * M_PI;
     k.x = k.range * std::cos(k.azimuth);
     k.y = -k.range * std::sin(k.azimuth);
     k.stamp_ns += std::llround(d * row_dt);
