@@ -1,6 +1,10 @@
 #pragma once
 // The `refined` estimator (issue 9): MC-RANSAC's inliers and velocity as the starting point
-// of a better model, chosen by measurement on synthetic drives (see test_odometry):
+// of a better model, chosen by measurement on synthetic drives (see test_odometry). It is
+// also the motion prior of the `keyframe` estimator (keyframe_tracker.hpp), which removes
+// most of its remaining drift (the per-scan heading random walk and turn entry/exit):
+// city route, full physics, 2026-11-22 build: refined 2.33 % / 0.0087 deg/m, keyframe
+// 0.77 % / 0.0031 (the figures in item 3 below are from an older simulator).
 //  1. Doppler inside the optimisation: each point is corrected with the velocity being
 //     estimated, p_c(v) = p + beta (u . v) u (u = beam unit vector), both scans.
 //  2. Residual covariance of both endpoints, S_m = R_cart(p_m2) + C_m R_cart(p_m1) C_m^T
