@@ -10,6 +10,7 @@
 #include "spinradar/diagnose/diagnose.hpp"
 #include "spinradar/diagnose/stats.hpp"
 #include "spinradar/diagnose/timing.hpp"
+#include "diagnose_steps.hpp"
 #include "timing_detail.hpp"
 
 namespace spinradar::diagnose {
@@ -157,8 +158,8 @@ void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_
       rr.push_back(o->fit_r + e0[col[o->scan]] * tau * o->dr[to]);
       ra.push_back(o->fit_az + e0[col[o->scan]] * tau * o->daz[to]);
     }
-    sr = std::max(robustSigma(rr), floor_r);
-    sa = std::max(robustSigma(ra), floor_az);
+    sr = detail::noiseScale(rr, floor_r);
+    sa = detail::noiseScale(ra, floor_az);
     for (size_t i = 0; i < rows.size(); ++i)
       keep[i] = std::fabs(rr[i]) < opt.outlier_sigma * sr && std::fabs(ra[i]) < opt.outlier_sigma * sa;
   }
@@ -192,10 +193,11 @@ void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_
       rr.push_back(fit.resid(j) * sr);
       ra.push_back(fit.resid(m + j) * sa);
     }
-    // Floored like the catalogue's scales: a mostly exact simulation has MAD 0, and without
-    // the floor every non-zero residual would be cut as an outlier.
-    const double nsr = std::max(robustSigma(rr), floor_r);
-    const double nsa = std::max(robustSigma(ra), floor_az);
+    // The catalogue's scales: the larger of the MAD and the 5 %-trimmed RMS, floored. Peak
+    // positions of noise-free renders are quantised (residuals 0 or +-half a bin): the MAD
+    // alone is then 0 and every non-zero residual would be cut as an outlier.
+    const double nsr = detail::noiseScale(rr, floor_r);
+    const double nsa = detail::noiseScale(ra, floor_az);
     for (int j = 0; j < m; ++j)
       keep[idx[j]] = std::fabs(rr[j]) < opt.outlier_sigma * nsr &&
                      std::fabs(ra[j]) < opt.outlier_sigma * nsa;
