@@ -256,7 +256,7 @@ void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_
                  fmt(std::sqrt(vbar), 2) + " (mean 1-sigma)";
     if (target_nuisance)
       f.evidence += "; scene mapped from the recording: the mapped positions absorb part of "
-                    "each scan's shift, so the spread is a lower bound (1.7-3x low in simulation)";
+                    "each scan's shift, so the spread is a lower bound (2-3.5x low in simulation)";
     f.details = {{"stretch", t.stretch}, {"stretch_sd", t.stretch_sd}, {"mean_stretch", wmean}};
     t.findings.push_back(f);
   }
