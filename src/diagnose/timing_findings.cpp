@@ -205,6 +205,9 @@ void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_
     sa = nsa;
   }
   t.jitter_tested = true;
+  double exact_zero = 0;  // returns whose residual is exactly 0 (quantised, noise-free peaks)
+  for (const Observation* o : rows) exact_zero += (o->fit_r == 0.0 && o->fit_az == 0.0);
+  exact_zero /= static_cast<double>(rows.size());
   t.stretch.assign(scans, 0.0);
   t.stretch_sd.assign(scans, 0.0);
   Eigen::VectorXd e(K);
@@ -257,7 +260,12 @@ void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_
     if (target_nuisance)
       f.evidence += "; scene mapped from the recording: the mapped positions absorb part of "
                     "each scan's shift, so the spread is a lower bound (2-3.5x low in simulation)";
-    f.details = {{"stretch", t.stretch}, {"stretch_sd", t.stretch_sd}, {"mean_stretch", wmean}};
+    if (exact_zero > 0.3)
+      f.evidence += "; " + fmt(100 * exact_zero, 2) + " % of the returns have exactly zero "
+                    "residual (quantised peaks): shifts below a quantisation step read as 0, so "
+                    "the spread is a lower bound";
+    f.details = {{"stretch", t.stretch}, {"stretch_sd", t.stretch_sd}, {"mean_stretch", wmean},
+                 {"exact_zero_fraction", exact_zero}};
     t.findings.push_back(f);
   }
 }
