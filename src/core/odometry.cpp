@@ -85,7 +85,9 @@ struct Odometry::Impl {
     c.validate();
     const bool features_changed = extractor && !sameFeatureConfig(config, c);
     config = c;
-    estimator = parseEstimator(c.estimator.estimator);
+    const Estimator next = parseEstimator(c.estimator.estimator);
+    if (next != estimator) keyframe.reset();  // its keyframe chain is stale after a switch
+    estimator = next;
     rigid.setConfig(c.estimator);
     mc.setConfig(c.estimator);
     refined.setConfig(c.estimator);

@@ -178,3 +178,23 @@ TEST(KeyframeTracker, PoseCovarianceIsHonest) {
   EXPECT_GT(nees, 0.3);
   EXPECT_LT(nees, 9.0);
 }
+
+TEST(KeyframeTracker, SwitchingEstimatorsKeepsThePoseContinuous) {
+  // keyframe -> mc_doppler -> keyframe through setConfig (dynamic_reconfigure): the old
+  // keyframe chain must not be reused after the switch back.
+  SyntheticScene scene(options(13), {Eigen::Vector3d(10.0, 0.0, 8.0 * kDeg)});
+  PipelineConfig cfg;
+  cfg.estimator.estimator = "keyframe";
+  Odometry odo(cfg);
+  OdometryResult res;
+  for (int k = 0; k < 18; ++k) {
+    if (k == 6 || k == 11) {
+      cfg.estimator.estimator = k == 6 ? "mc_doppler" : "keyframe";
+      odo.setConfig(cfg);
+    }
+    res = odo.process(scene.observe(k));
+    if (k > 0) EXPECT_TRUE(res.ok) << k;
+  }
+  const Eigen::Matrix3d truth = scene.pose(scene.scanStart(17));
+  EXPECT_LT((res.T_world_sensor.topRightCorner<2, 1>() - truth.topRightCorner<2, 1>()).norm(), 0.1);
+}
