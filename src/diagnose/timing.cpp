@@ -328,9 +328,31 @@ TimingReport analyseStamps(const std::vector<PolarScan>& scans, double rotation_
   } else if (K == 1) {
     t.period_mean = t.period.front();
   }
+  // Scan start times: a second view of the period, from the clock that stamps the scans.
+  if (t.start_gap.size() >= 2 && t.period_mean > 0) {
+    std::vector<double> g;
+    for (double x : t.start_gap) {
+      const double m = std::max(1.0, std::round(x / t.period_mean));  // skipped scans
+      g.push_back(x / m);
+    }
+    double mean = 0, ss = 0;
+    for (double x : g) mean += x / g.size();
+    for (double x : g) ss += (x - mean) * (x - mean);
+    t.start_gap_mean = mean;
+    t.start_gap_rel_std = std::sqrt(ss / (g.size() - 1)) / mean;
+    if (t.start_gap_rel_std > 0.005 || std::fabs(mean - t.period_mean) > 0.005 * t.period_mean)
+      t.notes.push_back(
+          "Scan start times are " + std::to_string(std::lround(mean * 1e6)) + " us apart on "
+          "average (relative std " + std::to_string(std::lround(t.start_gap_rel_std * 1e4) / 100.0)
+              .substr(0, 5) + " % over " + std::to_string(g.size()) + " gaps) while the row stamps "
+          "give " + std::to_string(std::lround(t.period_mean * 1e6)) + " us per rotation. "
+          "Whether the rotation or the clock that stamps the scans varies cannot be told from "
+          "the stamps alone; if the row stamps are made up from one time per scan (RADIATE), "
+          "they say nothing about the rotation.");
+  }
   if (rotation_hz > 0)
-    t.notes.push_back("Nominal period " + std::to_string(std::lround(1e6 / rotation_hz)) +
-                      " us (sensor configuration).");
+    t.notes.push_back("Period in the sensor configuration: " +
+                      std::to_string(std::lround(1e6 / rotation_hz)) + " us.");
   detail::addStampFindings(t, opt);
   return t;
 }

@@ -341,7 +341,8 @@ nlohmann::json TimingReport::toJson() const {
                  {"mean_s", period_mean},     {"relative_std", period_rel_std},
                  {"relative_std_sd", period_rel_std_sd}, {"chi2", period_chi2},
                  {"dof", period_dof},         {"p_value", period_p},
-                 {"start_gaps_s", start_gap}};
+                 {"start_gaps_s", start_gap},  {"start_gap_mean_s", start_gap_mean},
+                 {"start_gap_relative_std", start_gap_rel_std}};
   j["jitter"] = {{"tested", jitter_tested},   {"stretch_per_scan", stretch},
                  {"stretch_sd", stretch_sd},  {"std", jitter_std},
                  {"std_sd", jitter_std_sd},   {"chi2", jitter_chi2},
@@ -377,7 +378,12 @@ std::string TimingReport::summaryMarkdown() const {
     s << "Rotation period from the stamps (ms):";
     for (size_t k = 0; k < period.size(); ++k) s << " " << fmt(period[k] * 1e3, 7);
     s << "; relative spread " << fmt(100 * period_rel_std, 3) << " % (chi2 "
-      << fmt(period_chi2, 4) << ", " << period_dof << " dof).\n\n";
+      << fmt(period_chi2, 4) << ", " << period_dof << " dof).";
+    if (!start_gap.empty())
+      s << " Scan start times: " << fmt(start_gap_mean * 1e3, 7) << " ms apart on average, "
+        << "relative std " << fmt(100 * start_gap_rel_std, 3) << " % over " << start_gap.size()
+        << " gaps.";
+    s << "\n\n";
   }
   if (jitter_tested)
     s << "Rotation jitter from the targets: std " << fmt(100 * jitter_std, 3) << " +- "

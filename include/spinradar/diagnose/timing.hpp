@@ -68,6 +68,7 @@ struct TimingReport {
   // Rotation period per scan from the stamps.
   std::vector<double> period, period_sd;  ///< s per scan
   std::vector<double> start_gap;      ///< s, first-firing-time differences of consecutive scans
+  double start_gap_mean = 0, start_gap_rel_std = 0;  ///< per rotation (skipped scans divided out)
   double period_mean = 0, period_rel_std = 0, period_rel_std_sd = 0;
   double period_chi2 = 0, period_p = 1;
   int period_dof = 0;
