@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "diagnose_steps.hpp"
+#include "spinradar/diagnose/chirp_doppler.hpp"
 
 namespace spinradar::diagnose {
 
@@ -44,6 +45,16 @@ DiagnoseReport catalogue(const DiagnoseInput& in, const DiagnoseOptions& opt) {
   return rep;
 }
 
+}  // namespace
+
+ChirpDopplerOptions chirpOptionsFor(const sim::PhysicsConfig& base) {
+  ChirpDopplerOptions o;
+  if (base.doppler > 0) o.beta = base.doppler;  // the base model's beta turns beta|v| into |v|
+  return o;
+}
+
+namespace {
+
 bool baseHasBursts(const sim::PhysicsConfig& base) {
   const auto it = base.extra.find("stamp_bursts");
   if (it == base.extra.end() || it->is_null()) return false;
@@ -60,6 +71,7 @@ DiagnoseReport diagnoseRecording(const DiagnoseInput& in, const DiagnoseOptions&
                                  bool with_world, const std::string& split) {
   const auto t_start = std::chrono::steady_clock::now();
   TimingReport timing = analyseStamps(in.scans, in.sensor.rotation_hz, opt.timing_options);
+  timing.chirp_doppler = chirpDopplerSummary(in.scans, chirpOptionsFor(in.base));
   DiagnoseOptions o = opt;
   o.timing = false;
   auto run = [&](const DiagnoseInput& x) {

@@ -361,6 +361,7 @@ nlohmann::json TimingReport::toJson() const {
                              {"details", f.details}});
   j["advice"] = advice;
   j["notes"] = notes;
+  if (!chirp_doppler.is_null()) j["chirp_doppler"] = chirp_doppler;
   return j;
 }
 
@@ -401,6 +402,18 @@ std::string TimingReport::summaryMarkdown() const {
   s << "**Timing model to use:**\n\n";
   for (const auto& a : advice) s << "- " << a << "\n";
   for (const auto& n : notes) s << "- Note: " << n << "\n";
+  if (!chirp_doppler.is_null()) {
+    const auto& c = chirp_doppler;
+    s << "\nIn-scan Doppler (alternating chirps, `spinradar chirp-doppler`): detected in "
+      << c["scans_detected"].get<int>() << " of " << c["scans_with_alternating_chirps"].get<int>()
+      << " scans; median beta |v| " << fmt(c["median_beta_v_m"].get<double>(), 3) << " m";
+    if (c.contains("median_speed_mps"))
+      s << ", median speed " << fmt(c["median_speed_mps"].get<double>(), 3) << " m/s given beta "
+        << fmt(c["beta_given_s"].get<double>(), 3) << " s";
+    s << ".\n";
+    for (const auto& r : c["per_scan"]) s << "- scan " << r["scan"].get<int>() << ": "
+                                          << r["verdict"].get<std::string>() << "\n";
+  }
   return s.str();
 }
 

@@ -6,6 +6,7 @@
 
 #include "command.hpp"
 #include "spinradar/core/scan_folder.hpp"
+#include "spinradar/diagnose/chirp_doppler.hpp"
 #include "spinradar/diagnose/diagnose.hpp"
 #ifdef SPINRADAR_HAVE_BAG
 #include "scan_bag.hpp"
@@ -17,7 +18,7 @@ namespace fs = std::filesystem;
 using namespace spinradar;
 
 struct DiagnoseArgs {
-  std::string recording, trajectory, world, base, out, map_split = "early-late";
+  std::string recording, trajectory, world, base, out, map_split = "auto";
   std::string format = "oxford";
   bool timing_only = false;
   double range_resolution = 0;  // 0: sensor.json or the default
@@ -71,6 +72,10 @@ void printTiming(const diagnose::TimingReport& t) {
               << " (z " << f.significance << ", " << f.scans << " scans)";
   std::cout << "\n";
   for (const auto& s : t.advice) std::cout << "  timing model: " << s << "\n";
+  if (!t.chirp_doppler.is_null())
+    for (const auto& r : t.chirp_doppler["per_scan"])
+      std::cout << "  in-scan Doppler (alternating chirps), scan " << r["scan"].get<int>() << ": "
+                << r["verdict"].get<std::string>() << "\n";
 }
 
 void run(const DiagnoseArgs& a) {
@@ -91,18 +96,19 @@ void run(const DiagnoseArgs& a) {
     diagnose::TimingReport t =
         diagnose::analyseStamps(in.scans, in.sensor.rotation_hz, diagnose::TimingOptions{});
     diagnose::adviseTiming(t, 0, 0);
+    t.chirp_doppler = diagnose::chirpDopplerSummary(in.scans, diagnose::chirpOptionsFor(in.base));
     diagnose::writeTimingReport(t, a.out, why);
     std::cout << "catalogue stage not run: " << why << "\n";
     printTiming(t);
     std::cout << "report in " << a.out << "\n";
   };
+  if (!a.base.empty()) in.base = sim::PhysicsConfig::load(a.base);
   if (a.timing_only || a.trajectory.empty()) {
     timingOnly(a.timing_only ? "--timing-only" : "no --trajectory given");
     return;
   }
   if (!a.world.empty()) in.world = sim::World::load(a.world);
   in.trajectory = sim::Trajectory::loadCsv(a.trajectory);
-  if (!a.base.empty()) in.base = sim::PhysicsConfig::load(a.base);
   for (auto& s : in.scans) s.range_resolution = in.sensor.range_resolution;
 
   diagnose::DiagnoseOptions opt;
@@ -148,7 +154,8 @@ SPINRADAR_COMMAND(
                      "World JSON (targets, walls); without it the scene is mapped from part of "
                      "the recording (--map-split)");
       app.add_option("--map-split", a->map_split,
-                     "Without --world: early-late, late-early or out-back (which scans map)");
+                     "Without --world, which scans map the scene: auto (out-back when the drive reverses "
+                     "heading, otherwise early-late; default), out-back, early-late, late-early");
       app.add_option("--base", a->base,
                      "Physics JSON the simulation uses (default: no effects)");
       app.add_option("--range-resolution", a->range_resolution,

@@ -259,3 +259,26 @@ TEST(ChirpDoppler, RealOxfordSawtoothScansAreNullsAndInjectionIsRecovered) {
   EXPECT_NEAR(*inj.vx, 9.0, 0.45);
   EXPECT_NEAR(*inj.vy, 0.0, 0.45);
 }
+
+// The check `spinradar diagnose` runs on a recording: only scans whose chirp flags alternate,
+// the speed from the base physics' beta; none for a sawtooth recording.
+TEST(ChirpDoppler, RecordingSummaryForDiagnose) {
+  const std::vector<PolarScan> alternating = {simScan(12.0, 0.0, true),
+                                              simScan(12.0, 0.0, true, kBeta, 5)};
+  EXPECT_TRUE(hasAlternatingChirps(alternating[0]));
+  sim::PhysicsConfig base;
+  base.doppler = kBeta;
+  const nlohmann::json s = chirpDopplerSummary(alternating, chirpOptionsFor(base));
+  ASSERT_FALSE(s.is_null());
+  EXPECT_EQ(s["scans_with_alternating_chirps"].get<int>(), 2);
+  EXPECT_EQ(s["scans_detected"].get<int>(), 2);
+  EXPECT_NEAR(s["median_speed_mps"].get<double>(), 12.0, 0.6);
+  EXPECT_NEAR(s["median_beta_v_m"].get<double>(), kBeta * 12.0, 0.05 * kBeta * 12.0);
+
+  const std::vector<PolarScan> sawtooth = {simScan(12.0, 0.0, false)};
+  EXPECT_FALSE(hasAlternatingChirps(sawtooth[0]));
+  EXPECT_TRUE(chirpDopplerSummary(sawtooth, chirpOptionsFor(base)).is_null());
+  // Without a base beta only beta |v| is reported.
+  const nlohmann::json no_beta = chirpDopplerSummary(alternating, chirpOptionsFor({}));
+  EXPECT_FALSE(no_beta.contains("median_speed_mps"));
+}

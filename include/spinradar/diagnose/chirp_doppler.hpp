@@ -12,10 +12,12 @@
 // without the sign flip (what a scan whose chirps do not alternate would show) is reported too.
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "spinradar/core/polar_scan.hpp"
+#include "spinradar/sim/physics.hpp"
 
 namespace spinradar::diagnose {
 
@@ -73,5 +75,17 @@ struct ChirpDopplerResult {
 
 /// Throws std::invalid_argument for bad options or a scan without rows / bins.
 ChirpDopplerResult estimateChirpDoppler(const PolarScan& scan, const ChirpDopplerOptions& options = {});
+
+/// True when the scan carries chirp flags that alternate from row to row (Boreas-RT layout).
+bool hasAlternatingChirps(const PolarScan& scan);
+
+/// The in-scan Doppler check of `spinradar diagnose`: estimateChirpDoppler on every scan with
+/// alternating chirp flags; null when no scan has them. Per-scan results, how many detected,
+/// and the medians of beta |v| (and of the speed when options.beta is set).
+/// Options for the check under a base physics (its Doppler beta, when on, gives the speed).
+ChirpDopplerOptions chirpOptionsFor(const sim::PhysicsConfig& base);
+
+nlohmann::json chirpDopplerSummary(const std::vector<PolarScan>& scans,
+                                   const ChirpDopplerOptions& options = {});
 
 }  // namespace spinradar::diagnose

@@ -36,8 +36,8 @@ struct DiagnoseOptions {
   double outlier_sigma = 5.0;     ///< residuals beyond this many robust sigmas are dropped
   uint64_t seed = 97;             ///< re-simulation noise seed
   bool resimulate_after = true;   ///< re-render with the fitted effects (before/after)
-  /// Treat every target's world position as a nuisance parameter (2 per target): for scene
-  /// models mapped from the recording, whose positions carry the effect's average.
+  /// Treat every target's world position as a nuisance parameter (2 per target). Off for maps
+  /// built from the recording too: their dependence on each effect is in the regressors.
   bool target_nuisance = false;
   /// Timing stage (timing.hpp): stamp analysis first (bursty stamps are replaced by the fitted
   /// uniform firing times before the catalogue stage), rotation jitter from the residuals after.
@@ -126,7 +126,7 @@ struct DiagnoseReport {
 DiagnoseReport diagnose(const DiagnoseInput& in, const DiagnoseOptions& opt = {});
 
 /// Without a world file (in.world ignored): builds the static scene from part of the recording
-/// (`split`: "early-late", "late-early", "out-back"; see scene_map.hpp) and diagnoses the rest.
+/// (`split`: "auto", "early-late", "late-early", "out-back"; see scene_map.hpp) and diagnoses the rest.
 DiagnoseReport diagnoseWithoutWorld(const DiagnoseInput& in, const DiagnoseOptions& opt = {},
                                     const std::string& split = "early-late");
 

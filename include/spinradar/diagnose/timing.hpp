@@ -78,6 +78,9 @@ struct TimingReport {
   double jitter_std = 0, jitter_std_sd = 0, jitter_chi2 = 0, jitter_p = 1;
   int jitter_dof = 0;
   std::vector<TimingFinding> findings;
+  /// In-scan Doppler of alternating chirps (chirpDopplerSummary; null when chirps do not
+  /// alternate). Not a timing effect, but like the stamps it needs no world or trajectory.
+  nlohmann::json chirp_doppler;
   std::vector<std::string> advice;    ///< the timing model to use, in words
   std::vector<std::string> notes;
 
