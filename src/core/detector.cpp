@@ -164,7 +164,7 @@ void Detector::detect(const PolarScan& scan, std::vector<Keypoint>& out) {
     detectCfar(scan, out);
   else
     detectCen2018(scan, out);
-  if (azimuth_peaks_) keepAzimuthPeaks(scan, out);
+  if (config_.azimuth_peaks) keepAzimuthPeaks(scan, out);
 }
 
 void Detector::keepAzimuthPeaks(const PolarScan& scan, std::vector<Keypoint>& out) const {

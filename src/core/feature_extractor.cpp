@@ -65,6 +65,9 @@ void FeatureExtractor::extract(const PolarScan& scan, FeatureFrame& out, StageTi
 
 const cv::Mat& FeatureExtractor::cartesianImage() const { return impl_->cart; }
 
-void FeatureExtractor::setAzimuthPeaks(bool on) { impl_->detector.setAzimuthPeaks(on); }
+void FeatureExtractor::setAzimuthPeaks(bool on) {
+  impl_->detector_config.azimuth_peaks = on;
+  impl_->detector.setAzimuthPeaks(on);
+}
 
 }  // namespace spinradar

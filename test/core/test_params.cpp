@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <type_traits>
+
 #include "spinradar/core/params.hpp"
 
 using namespace spinradar;
@@ -30,4 +32,19 @@ TEST(Params, VisitSeesEveryParameterOnce) {
   });
   EXPECT_TRUE(saw_beta);
   EXPECT_GT(n, 15);
+}
+
+TEST(Params, AzimuthPeaksIsADetectorParameterOffByDefault) {
+  // Off reproduces the paper's front end (one keypoint per azimuth row).
+  PipelineConfig c;
+  EXPECT_FALSE(c.detector.azimuth_peaks);
+  int seen = 0;
+  c.detector.visit([&](const ParamMeta& m, auto& v) {
+    if (std::string(m.name) != "azimuth_peaks") return;
+    ++seen;
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, bool>) v = true;
+  });
+  EXPECT_EQ(seen, 1);
+  EXPECT_TRUE(c.detector.azimuth_peaks);
+  EXPECT_NO_THROW(c.validate());
 }

@@ -7,6 +7,7 @@
 // see Detector::setAzimuthPeaks).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <random>
@@ -16,6 +17,9 @@
 #include "spinradar/core/feature_extractor.hpp"
 #include "spinradar/core/matcher.hpp"
 #include "spinradar/core/mc_ransac.hpp"
+// The CLI's option layer is not a library; compiled in here so that the test goes through the
+// same `--azimuth-peaks` / YAML path as `spinradar odometry`.
+#include "../../src/tools/pipeline_options.cpp"
 
 using namespace spinradar;
 using namespace spinradar::sim;
@@ -136,4 +140,68 @@ TEST(KeypointTruth, SteadyTurnYawRateThroughTheFrontEnd) {
               << ", azimuth peaks " << peaks << "\n";
     EXPECT_NEAR(peaks, 1.0, 0.003) << "wz " << wz;
   }
+}
+
+TEST(KeypointTruth, AzimuthPeaksParameterFromTheCommandLineGivesSubRowAzimuths) {
+  // A still sensor and point targets at known bearings a fraction of a row off the row angles
+  // (rows at a * 2 pi / 400). With `--azimuth-peaks 1` (CLI options -> PipelineConfig ->
+  // FeatureExtractor, as `spinradar odometry` builds it) each target gives one keypoint within
+  // +-2 rows, at its bearing within 0.1 row (measured <= 0.05), i.e. off the row angle. Without
+  // it (the default) each target gives keypoints on the 4 rows its beam covers, all exactly at
+  // row angles. Both detectors. (The sidelobes ~3 rows off are azimuthal peaks of their own and
+  // not counted.)
+  const double fracs[] = {0.3, -0.3, 0.4, -0.4, 0.25, -0.2};
+  World world;
+  std::vector<std::pair<double, double>> truth;  // bearing (rows, clockwise), range (m)
+  for (int i = 0; i < 6; ++i) {
+    const double rows = 30 + 60 * i + fracs[i], r = 25.0 + 12.0 * i;
+    const double phi = rows * kStep;
+    world.targets.push_back({r * std::cos(phi), -r * std::sin(phi), 15.0, 0, 0});
+    truth.emplace_back(rows, r);
+  }
+  Simulator sim(world, constantMotion(0.0, 0.0, {}, 2.0), SensorConfig{}, PhysicsConfig{}, 5);
+  const PolarScan scan = sim.renderScan(2);
+  ASSERT_EQ(scan.azimuths, 400);
+  for (int a : {0, 30, 399}) ASSERT_NEAR(scan.azimuth[a], a * kStep, 1e-9);
+
+  for (const char* detector : {"cen2018", "cfar"}) {
+    for (bool peaks : {false, true}) {
+      CLI::App app;
+      cli::PipelineOptions opts;
+      opts.add(app);
+      std::vector<std::string> args = {"--detector", detector};
+      if (peaks) args.insert(args.end(), {"--azimuth-peaks", "1"});
+      std::reverse(args.begin(), args.end());  // CLI11 takes the arguments last-first
+      app.parse(args);
+      const PipelineConfig cfg = opts.resolve();
+      ASSERT_EQ(cfg.detector.azimuth_peaks, peaks);
+      FeatureExtractor fx(cfg.detector, cfg.features);
+      FeatureFrame f;
+      fx.extract(scan, f);
+      for (const auto& [rows, r] : truth) {
+        int n = 0;
+        for (const Keypoint& k : f.keypoints) {
+          const double da = std::remainder(k.azimuth / kStep - rows, 400.0);
+          if (std::abs(da) > 2.0 || std::abs(k.range - r) > 1.0) continue;
+          ++n;
+          const double off_row = std::abs(std::remainder(k.azimuth / kStep, 1.0));
+          if (peaks) {
+            EXPECT_LT(std::abs(da), 0.1) << detector << " target at row " << rows;
+            EXPECT_GT(off_row, 0.05) << detector << " target at row " << rows;
+          } else {
+            EXPECT_LT(off_row, 1e-9) << detector << " target at row " << rows;
+          }
+        }
+        if (peaks)
+          EXPECT_EQ(n, 1) << detector << " target at row " << rows;
+        else
+          EXPECT_GE(n, 3) << detector << " target at row " << rows;
+      }
+    }
+  }
+  // The YAML form reaches the same field.
+  PipelineConfig cfg;
+  cli::setPipelineParam(cfg, "azimuth_peaks", "true", "test");
+  EXPECT_TRUE(cfg.detector.azimuth_peaks);
+  EXPECT_THROW(cli::setPipelineParam(cfg, "azimuth_peaks", "2", "test"), std::invalid_argument);
 }

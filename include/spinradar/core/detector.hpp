@@ -23,15 +23,15 @@ class Detector {
   void setConfig(const DetectorConfig& config);
   const DetectorConfig& config() const { return config_; }
 
-  /// Off (default, the paper's Cen2018): one keypoint per row per run, at the row's angle and
-  /// time. On: of the rows that see the same return (same range +-2 bins), only the row with
-  /// the highest power is kept, moved to a sub-row azimuth (parabola through the neighbouring
-  /// rows) and the matching time. Row keypoints are not fixed world points: when a turn moves
-  /// every target by a fractional number of rows, descriptor matching pairs rows with the
-  /// nearest whole-row shift, which biased the yaw rate by up to ~1 % on simulated turns;
-  /// azimuth peaks remove that (test/sim/test_keypoint_truth.cpp).
-  void setAzimuthPeaks(bool on) { azimuth_peaks_ = on; }
-  bool azimuthPeaks() const { return azimuth_peaks_; }
+  /// DetectorConfig::azimuth_peaks. Off (default, the paper's Cen2018): one keypoint per row per
+  /// run, at the row's angle and time. On (both detectors): of the rows that see the same return
+  /// (same range +-2 bins), only the row with the highest power is kept, moved to a sub-row
+  /// azimuth (parabola through the neighbouring rows) and the matching time. Row keypoints are
+  /// not fixed world points: when a turn moves every target by a fractional number of rows,
+  /// descriptor matching pairs rows with the nearest whole-row shift, which biased the yaw rate
+  /// by up to ~1 % on simulated turns; azimuth peaks remove that (test/sim/test_keypoint_truth.cpp).
+  void setAzimuthPeaks(bool on) { config_.azimuth_peaks = on; }
+  bool azimuthPeaks() const { return config_.azimuth_peaks; }
 
   /// Clears `out` and fills it with the keypoints of `scan` (config.detector selects the method).
   void detect(const PolarScan& scan, std::vector<Keypoint>& out);
@@ -52,12 +52,11 @@ class Detector {
  private:
   void emit(const PolarScan& scan, int a, double bin, float score, std::vector<Keypoint>& out) const;
   void rangeWindow(const PolarScan& scan, int& b0, int& b1) const;
-  /// Azimuthal peaks only (see setAzimuthPeaks).
+  /// Azimuthal peaks only (DetectorConfig::azimuth_peaks).
   void keepAzimuthPeaks(const PolarScan& scan, std::vector<Keypoint>& out) const;
   void rebuildKernel();
 
   DetectorConfig config_;
-  bool azimuth_peaks_ = false;
   int radius_ = 0;               ///< Gaussian half width in bins
   std::vector<int16_t> kernel_;  ///< fixed-point Gaussian taps (sum 2^15), zero-padded to 8k
   std::vector<uint8_t> padded_;  ///< one row with reflected borders

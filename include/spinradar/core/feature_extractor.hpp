@@ -27,8 +27,7 @@ class FeatureExtractor {
   /// sensor at the centre, x forward = up, y left = left). For debug display.
   const cv::Mat& cartesianImage() const;
 
-  /// Keypoints at azimuthal peaks with sub-row azimuths (Detector::setAzimuthPeaks); off by
-  /// default. Not yet a DetectorConfig parameter.
+  /// Overrides DetectorConfig::azimuth_peaks (keypoints at azimuthal peaks, sub-row azimuths).
   void setAzimuthPeaks(bool on);
 
  private:
