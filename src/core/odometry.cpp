@@ -165,6 +165,9 @@ struct Odometry::Impl {
         Eigen::Matrix3d T_new, P_new;
         keyframe.track(cur.frame, T_world, pose_cov, config.features.nndr, m, T_new, P_new);
         setPose(T_new, P_new);
+        res.keyframe_stamp_ns = keyframe.keyframeStamp();
+        res.T_keyframe_sensor = keyframe.relativePose();
+        res.keyframe_cov = keyframe.relativeCov();
         dopplerCorrect(cur.frame.keypoints, m.velocity, config.estimator.beta, corr2);
       } else if (!ok) {
         keyframe.reset();  // the prediction below is not tied to the keyframe

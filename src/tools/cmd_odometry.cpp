@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <future>
 #include <iostream>
 #include <memory>
@@ -22,7 +23,7 @@ namespace {
 using namespace spinradar;
 
 struct OdometryArgs {
-  std::string input, out, format = "auto";
+  std::string input, out, format = "auto", cov_out;
   double range_resolution = 0.0;
   int threads = 1;
   bool quiet = false;
@@ -66,6 +67,21 @@ void run(OdometryArgs& a) {
 
   Odometry odometry(cfg);
   PoseCsvWriter writer(a.out);
+  std::ofstream cov;
+  if (!a.cov_out.empty()) {
+    cov.open(a.cov_out);
+    if (!cov) throw std::runtime_error(a.cov_out + ": cannot open for writing");
+    cov.precision(10);
+    cov << "t,ok,pose_xx,pose_xy,pose_xyaw,pose_yy,pose_yyaw,pose_yawyaw,"
+           "step_xx,step_xy,step_xyaw,step_yy,step_yyaw,step_yawyaw,"
+           "vel_xx,vel_xy,vel_xw,vel_yy,vel_yw,vel_ww,"
+           "key_t,key_x,key_y,key_yaw,key_xx,key_xy,key_xyaw,key_yy,key_yyaw,key_yawyaw\n";
+  }
+  // Upper triangle of a symmetric 3x3, row-major.
+  auto writeCov = [&cov](const Eigen::Matrix3d& C) {
+    cov << ',' << C(0, 0) << ',' << C(0, 1) << ',' << C(0, 2) << ',' << C(1, 1) << ','
+        << C(1, 2) << ',' << C(2, 2);
+  };
   cli::Progress progress("scan", folder.size());
   StageTimes totals;
   double load_ms = 0;
@@ -100,10 +116,25 @@ void run(OdometryArgs& a) {
       p.wz = r.motion.velocity(2);
     }
     writer.write(p);
+    if (cov.is_open()) {
+      const Eigen::Matrix3d& K = r.T_keyframe_sensor;
+      cov << p.t << ',' << (r.ok ? 1 : 0);
+      writeCov(r.pose_cov);
+      writeCov(r.motion.T_12_cov);
+      writeCov(r.motion.velocity_cov);
+      cov << ',' << r.keyframe_stamp_ns * 1e-9 << ',' << K(0, 2) << ',' << K(1, 2) << ','
+          << std::atan2(K(1, 0), K(0, 0));
+      writeCov(r.keyframe_cov);
+      cov << '\n';
+    }
     if (!a.quiet)
       progress.update(i + 1, failures ? std::to_string(failures) + " failed estimate(s)" : "");
   }
   writer.close();
+  if (cov.is_open()) {
+    cov.close();
+    if (!cov) throw std::runtime_error(a.cov_out + ": write failed");
+  }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   printStageTotals(totals, load_ms, folder.size(), wall);
@@ -139,6 +170,12 @@ SPINRADAR_COMMAND(
                      "0 = all cores")
           ->check(CLI::NonNegativeNumber);
       app.add_flag("--quiet,-q", a->quiet, "No progress line");
+      app.add_option("--covariance-out", a->cov_out,
+                     "Also write each scan's covariances over [x, y, yaw] / [vx, vy, wz] (upper "
+                     "triangles) to this CSV: accumulated pose (as published on ROS), the "
+                     "frame-to-frame step (for keyframe: the refined pair's, its prior), body "
+                     "velocity, and for --estimator keyframe the pose relative to its keyframe "
+                     "(key_t: the keyframe's stamp, 0 for other estimators) with its covariance");
       a->pipeline.add(app);
       app.callback([a] { run(*a); });
     });

@@ -37,6 +37,11 @@ struct OdometryResult {
   Eigen::Matrix3d T_world_sensor = Eigen::Matrix3d::Identity();  ///< world = first scan
   Eigen::Matrix3d pose_cov = Eigen::Matrix3d::Zero();            ///< accumulated, [x, y, yaw]
   MotionEstimate motion;    ///< last frame-to-frame estimate
+  /// Keyframe estimator only (else keyframe_stamp_ns = 0): the pose relative to the keyframe
+  /// the scan was registered to (the scan at keyframe_stamp_ns) and its covariance.
+  int64_t keyframe_stamp_ns = 0;
+  Eigen::Matrix3d T_keyframe_sensor = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d keyframe_cov = Eigen::Matrix3d::Zero();
   StageTimes times;
 };
 
