@@ -243,7 +243,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
       C_pub = L * (cov_pub.topLeftCorner<3, 3>() + tb * tb * key_xi_cov_) * L.transpose();
       xi_cov_pub = cov_pub.bottomRightCorner<3, 3>();
       pair.velocity = xi;
-      pair.velocity_cov = cov.bottomRightCorner<3, 3>();
+      pair.velocity_cov = xi_cov_pub;  // published; nothing downstream chains on it
     }
   }
   compound(T_wj_, P_j_, T_jk, C_pub, T_w, P);
