@@ -4,13 +4,18 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <algorithm>
+#include <map>
 #include <memory>
+#include <sstream>
 
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
 #include "spinradar/core/evaluation.hpp"
+#include "spinradar/core/lie.hpp"
 #include "spinradar/core/plot.hpp"
 
 namespace {
@@ -19,6 +24,7 @@ using namespace spinradar;
 
 struct EvalArgs {
   std::vector<std::string> est, labels;
+  std::vector<std::string> cov;
   std::string gt, plot, json;
   int step = 10;
   int frames_listed = 20;
@@ -125,9 +131,128 @@ nlohmann::json toJson(const EvaluationReport& r, const std::string& label, const
   return j;
 }
 
+/// NEES e^T C^-1 e of a set of [x, y, yaw] errors: count, mean, median, share under the 95 %
+/// chi2 bound of 3 degrees of freedom.
+nlohmann::json neesSummary(std::vector<double> v) {
+  nlohmann::json j = {{"n", v.size()}};
+  if (v.empty()) return j;
+  double sum = 0.0, covered = 0.0;
+  for (double x : v) {
+    sum += x;
+    covered += x < 7.815;
+  }
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  j["mean"] = sum / v.size();
+  j["median"] = v[v.size() / 2];
+  j["covered_pct"] = 100.0 * covered / v.size();
+  return j;
+}
+
+double nees(const Eigen::Matrix3d& est, const Eigen::Matrix3d& truth, const Eigen::Matrix3d& C) {
+  Eigen::Vector3d e = se2::toXyYaw(est) - se2::toXyYaw(truth);
+  e(2) = std::remainder(e(2), 2.0 * M_PI);
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(C);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return -1.0;
+  return e.dot(ldlt.solve(e));
+}
+
+/// Honesty of the covariances `spinradar odometry --covariance-out` wrote next to `est`:
+/// NEES against the truth of the accumulated pose (relative to the first scan, as published)
+/// and, for the keyframe estimator, of each scan's pose relative to its keyframe (what one
+/// registration measures; independent between keyframes).
+nlohmann::json covarianceNees(const std::string& path, const PoseFile& est,
+                              const std::vector<PoseRecord>& gt) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open");
+  std::string line;
+  std::getline(in, line);
+  std::map<std::string, size_t> col;
+  {
+    std::stringstream ss(line);
+    std::string name;
+    for (size_t i = 0; std::getline(ss, name, ','); ++i) col[name] = i;
+  }
+  const char* need[] = {"t", "ok", "pose_xx", "pose_xy", "pose_xyaw", "pose_yy", "pose_yyaw",
+                        "pose_yawyaw", "key_t", "key_x", "key_y", "key_yaw", "key_xx", "key_xy",
+                        "key_xyaw", "key_yy", "key_yyaw", "key_yawyaw"};
+  for (const char* n : need)
+    if (!col.count(n))
+      throw std::runtime_error(path + ": line 1: no column '" + n +
+                               "' (expected the CSV of spinradar odometry --covariance-out)");
+  auto cov3 = [](const std::vector<double>& v, size_t i) {
+    Eigen::Matrix3d C;
+    C << v[i], v[i + 1], v[i + 2], v[i + 1], v[i + 3], v[i + 4], v[i + 2], v[i + 4], v[i + 5];
+    return C;
+  };
+  if (est.poses.empty()) return {};
+  PoseRecord g0;
+  const double t0 = est.poses.front().t;
+  if (!interpolatePose(gt, t0, g0)) throw std::runtime_error(path + ": first scan outside the truth");
+  const Eigen::Matrix3d Ei = se2::inverse(poseMatrix(est.poses.front()));
+  const Eigen::Matrix3d Gi = se2::inverse(poseMatrix(g0));
+  std::vector<double> pose_nees, key_nees;
+  size_t k = 0;
+  for (int lineno = 2; std::getline(in, line); ++lineno) {
+    if (line.empty()) continue;
+    std::vector<double> v;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) {
+      try {
+        v.push_back(std::stod(cell));
+      } catch (const std::exception&) {
+        throw std::runtime_error(path + ": line " + std::to_string(lineno) + ": '" + cell +
+                                 "' is not a number");
+      }
+    }
+    if (v.size() < col.size())
+      throw std::runtime_error(path + ": line " + std::to_string(lineno) + ": " +
+                               std::to_string(v.size()) + " columns, expected " +
+                               std::to_string(col.size()));
+    const double t = v[col["t"]];
+    while (k < est.poses.size() && est.poses[k].t < t - 1e-6) ++k;
+    if (k == est.poses.size() || std::abs(est.poses[k].t - t) > 1e-6)
+      throw std::runtime_error(path + ": line " + std::to_string(lineno) + ": t = " +
+                               std::to_string(t) + " is not a time of the odometry CSV");
+    PoseRecord g, gk;
+    if (v[col["ok"]] == 0.0 || !interpolatePose(gt, t, g)) continue;
+    const Eigen::Matrix3d G = poseMatrix(g);
+    const double pn = nees(Ei * poseMatrix(est.poses[k]), Gi * G, cov3(v, col["pose_xx"]));
+    if (pn >= 0.0) pose_nees.push_back(pn);
+    const double kt = v[col["key_t"]];
+    if (kt > 0.0 && std::abs(kt - t) > 1e-6 && interpolatePose(gt, kt, gk)) {
+      const Eigen::Matrix3d rel = poseMatrix(v[col["key_x"]], v[col["key_y"]], v[col["key_yaw"]]);
+      const double kn = nees(rel, se2::inverse(poseMatrix(gk)) * G, cov3(v, col["key_xx"]));
+      if (kn >= 0.0) key_nees.push_back(kn);
+    }
+  }
+  return {{"pose", neesSummary(pose_nees)}, {"keyframe_relative", neesSummary(key_nees)}};
+}
+
+std::string formatNees(const nlohmann::json& j) {
+  std::string out = "covariance honesty: NEES over [x, y, yaw] (expected 3; 95 % chi2 bound 7.815)\n";
+  for (const auto& [key, name] : {std::pair<const char*, const char*>{"keyframe_relative",
+                                                                      "pose relative to keyframe"},
+                                  {"pose", "accumulated pose"}}) {
+    const auto& s = j[key];
+    char buf[200];
+    if (s.value("n", 0) == 0)
+      std::snprintf(buf, sizeof buf, "  %-26s none\n", name);
+    else
+      std::snprintf(buf, sizeof buf, "  %-26s %5d scans: mean %.2f, median %.2f, within bound %.1f %%\n",
+                    name, s["n"].get<int>(), s["mean"].get<double>(), s["median"].get<double>(),
+                    s["covered_pct"].get<double>());
+    out += buf;
+  }
+  return out;
+}
+
 void run(EvalArgs& a) {
   if (!a.labels.empty() && a.labels.size() != a.est.size())
     throw std::runtime_error("--label given " + std::to_string(a.labels.size()) +
+                             " times for " + std::to_string(a.est.size()) + " --est files");
+  if (!a.cov.empty() && a.cov.size() != a.est.size())
+    throw std::runtime_error("--covariance given " + std::to_string(a.cov.size()) +
                              " times for " + std::to_string(a.est.size()) + " --est files");
   std::vector<std::string> labels = a.labels;
   if (labels.empty())
@@ -148,6 +273,11 @@ void run(EvalArgs& a) {
     std::cout << "== " << labels[i] << " (" << a.est[i] << ")\n"
               << formatReport(r, a.frames_listed);
     all.push_back(toJson(r, labels[i], a.est[i]));
+    if (!a.cov.empty()) {
+      const nlohmann::json n = covarianceNees(a.cov[i], est, gt);
+      std::cout << formatNees(n);
+      all.back()["nees"] = n;
+    }
     reports.push_back(std::move(r));
   }
   if (reports.size() > 1) {
@@ -192,6 +322,10 @@ SPINRADAR_COMMAND(
       app.add_option("--gt,-g", a->gt,
                      "Ground truth: t,x,y,yaw CSV or the Oxford gt/radar_odometry.csv")
           ->required()
+          ->check(CLI::ExistingFile);
+      app.add_option("--covariance", a->cov,
+                     "CSV of spinradar odometry --covariance-out, one per --est: adds the NEES "
+                     "of the published covariances against the truth")
           ->check(CLI::ExistingFile);
       app.add_option("--plot", a->plot,
                      "PNG: trajectory vs truth, frame errors, drift vs length and vs speed");
