@@ -185,9 +185,8 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   // The pair step assumes a smooth velocity; its covariance does not know that the yaw rate
   // can step (turn entry and exit: measured 1-2 deg errors of that step). Inflate it by
   // white-noise acceleration over the step so the registration can overrule it there.
-  const double ql = 0.5 * kStepAccelSigma * dt * dt, qa = 0.5 * kStepAngAccelSigma * dt * dt;
   Eigen::Matrix3d C_12 = pair.T_12_cov;
-  C_12.diagonal() += Eigen::Vector3d(ql * ql, ql * ql, qa * qa);
+  C_12.diagonal() += stepModelNoise(dt);
   Eigen::Matrix3d T_odo, C_odo;
   compound(T_jprev_, C_jprev_, pair.T_12, C_12, T_odo, C_odo);
   Eigen::Matrix3d T_jk = T_odo, C_jk = C_odo;

@@ -57,6 +57,14 @@ class KeyframeTracker {
              const Eigen::Matrix3d& P_prev, double nndr, MotionEstimate& pair,
              Eigen::Matrix3d& T_w, Eigen::Matrix3d& P);
 
+  /// Variances over [x, y, yaw] of what a constant-velocity step of dt seconds leaves out:
+  /// white-noise acceleration (kStepAccelSigma, kStepAngAccelSigma) over the step. Added to
+  /// the pair step here (the prior) and to the refined estimator's published step.
+  static Eigen::Vector3d stepModelNoise(double dt) {
+    const double ql = 0.5 * kStepAccelSigma * dt * dt, qa = 0.5 * kStepAngAccelSigma * dt * dt;
+    return Eigen::Vector3d(ql * ql, ql * ql, qa * qa);
+  }
+
   int lastInliers() const { return last_inliers_; }
   /// The last tracked scan's pose relative to its keyframe (the scan at keyframeStamp(); the
   /// keyframe in use when the scan was registered, even if the scan then became the next
