@@ -175,11 +175,12 @@ struct Odometry::Impl {
       times.estimate_ms = msSince(t0);
       const double dt_ref = 1e-9 * static_cast<double>(cur.frame.stamp_ns - prev.frame.stamp_ns);
       if (ok) {
-        if (estimator == Estimator::kRefined) {
+        if (estimator == Estimator::kRefined || estimator == Estimator::kKeyframe) {
           // Published covariance (NEES on the city route): the refined step and velocity
           // assume a constant velocity over the pair; add what acceleration over the step
           // leaves out, the same model the keyframe estimator puts on this step as its prior.
-          // Covariance only: the pose and the estimate are unchanged.
+          // Covariance only: the pose and the estimate are unchanged. (For keyframe: the
+          // refined pair's step and velocity, the latter published, see keyframe_tracker.cpp.)
           const Eigen::Vector3d q = KeyframeTracker::stepModelNoise(dt_ref);
           m.T_12_cov.diagonal() += q;
           const double h = 0.5 * dt_ref;  // the velocity stands for the step's centre

@@ -50,7 +50,8 @@ class KeyframeTracker {
   void reset() { has_key_ = has_last_stamp_ = false; }
 
   /// cur: the newest scan (raw keypoints and descriptors). pair: the frame-to-frame estimate
-  /// from the previous scan to cur (ok), updated in place (velocity, velocity_cov, T_12).
+  /// from the previous scan to cur (ok); T_12 is updated in place to the step actually taken
+  /// (velocity and velocity_cov stay the refined pair's: published, see the .cpp).
   /// T_w_prev, P_prev: pose of the previous scan and its [x, y, yaw] covariance; T_w, P
   /// receive cur's. nndr: ratio test for matching against the keyframe.
   void track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_prev,
