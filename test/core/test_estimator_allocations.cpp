@@ -1,4 +1,3 @@
-// (the counting operator new below pairs malloc with free on purpose)
 // Hot-path check: once warmed up on a scan pair, the estimators, Doppler correction and
 // undistortion do not allocate.
 #include <gtest/gtest.h>
@@ -7,6 +6,7 @@
 #include <cstdlib>
 #include <new>
 
+#include "core/count_allocations.hpp"
 #include "core/synthetic_scene.hpp"
 #include "spinradar/core/doppler.hpp"
 #include "spinradar/core/mc_ransac.hpp"
@@ -15,15 +15,6 @@
 #include "spinradar/core/undistort.hpp"
 
 using namespace spinradar;
-
-static std::atomic<long> g_allocations{0};
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 TEST(EstimatorAllocations, NoneAfterWarmUp) {
   spinradar::testing::SceneOptions o;

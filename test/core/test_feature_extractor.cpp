@@ -1,5 +1,3 @@
-// (the counting operator new below pairs malloc with free on purpose)
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 // The whole feature chain: keypoints and descriptors stay aligned, known motion is recovered by
 // the matches, and on real Oxford scans the matches agree with the dataset's odometry. Prints
 // per-stage timings (no wall-clock assertions).
@@ -13,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/count_allocations.hpp"
 #include "core/feature_test_utils.hpp"
 #include "spinradar/core/cartesian.hpp"
 #include "spinradar/core/detector.hpp"
@@ -22,16 +21,6 @@
 
 using namespace spinradar;
 using spinradar::test::Target;
-
-// Counts heap allocations made through operator new in this test binary (hot-path check).
-static std::atomic<long> g_allocations{0};
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 

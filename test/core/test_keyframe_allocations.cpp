@@ -1,4 +1,3 @@
-// (the counting operator new below pairs malloc with free on purpose)
 // Hot-path check for the keyframe estimator: once warmed up (keyframe taken, buffers grown),
 // a scan through Odometry::process(FeatureFrame) does not allocate.
 #include <gtest/gtest.h>
@@ -8,19 +7,11 @@
 #include <iostream>
 #include <new>
 
+#include "core/count_allocations.hpp"
 #include "core/synthetic_scene.hpp"
 #include "spinradar/core/odometry.hpp"
 
 using namespace spinradar;
-
-static std::atomic<long> g_allocations{0};
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 TEST(KeyframeAllocations, NoneAfterWarmUp) {
   spinradar::testing::SceneOptions o;
