@@ -8,6 +8,7 @@
 #   SPINRADAR_DEMO_SECONDS  length of the live run in seconds (default 60)
 #   SPINRADAR_DEMO_SCENE    city, out_and_back or tight_turns (default city)
 #   SPINRADAR_DEMO_RATE     bag playback speed factor (default 25, i.e. 100 scans/s offered)
+#   SPINRADAR_DEMO_ESTIMATOR rigid, mc, mc_doppler, refined or keyframe (default: config/spinradar.yaml)
 #   SPINRADAR_DEMO_SKIP_BUILD=1  use the existing build as is
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -19,6 +20,7 @@ build="${SPINRADAR_BUILD_DIR:-$root/build}"
 seconds="${SPINRADAR_DEMO_SECONDS:-60}"
 scene="${SPINRADAR_DEMO_SCENE:-city}"
 play_rate="${SPINRADAR_DEMO_RATE:-25}"
+estimator="${SPINRADAR_DEMO_ESTIMATOR:-}"
 out="$build/demo"
 rm -rf "$out" && mkdir -p "$out"
 export PATH=/usr/bin:$PATH
@@ -37,7 +39,7 @@ for _ in $(seq 50); do rosparam list > /dev/null 2>&1 && break; sleep 0.2; done
 echo "[demo] live run: scene '$scene' served on 127.0.0.1:$sensor_port at 4 Hz for $seconds s"
 rosbag record -q -O "$out/live.bag" scan __name:=recorder > "$out/record.log" 2>&1 & rec=$!; pids+=($rec)
 roslaunch spinradar sim.launch scene:="$scene" rate:=1 sim_clock:=true port:="$sensor_port" \
-  monitor:=true odom_csv:="$out/live_odom.csv" summary:="$out/live_summary.json" \
+  estimator:="$estimator" monitor:=true odom_csv:="$out/live_odom.csv" summary:="$out/live_summary.json" \
   > "$out/live.log" 2>&1 & live=$!; pids+=($live)
 sleep "$seconds"
 kill -INT "$live" "$rec"; wait "$live" "$rec" || true
@@ -49,12 +51,13 @@ echo "[demo] drift of the live odometry against the true trajectory:"
 
 echo "[demo] live run on the wall clock (as a real sensor stamps), for latency from the last azimuth"
 roslaunch spinradar sim.launch scene:="$scene" rate:=1 sim_clock:=false port:=$(( sensor_port + 1 )) \
-  monitor:=true summary:="$out/wallclock_summary.json" > "$out/wallclock.log" 2>&1 & wall=$!; pids+=($wall)
+  estimator:="$estimator" monitor:=true summary:="$out/wallclock_summary.json" > "$out/wallclock.log" 2>&1 & wall=$!; pids+=($wall)
 sleep 20
 kill -INT "$wall"; wait "$wall" || true
 
 echo "[demo] bag playback of the live run's scans at ${play_rate}x (simulated time)"
 roslaunch spinradar rosbag.launch bag:="$out/live.bag" rate:="$play_rate" delay:=3 monitor:=true \
+  estimator:="$estimator" \
   odom_csv:="$out/playback_odom.csv" summary:="$out/playback_summary.json" \
   > "$out/playback.log" 2>&1 || true
 
