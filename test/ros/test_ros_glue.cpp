@@ -74,7 +74,7 @@ TEST(ReconfigureEntries, EstimatorIsAnEnumOfItsChoices) {
     for (const auto& p : g.parameters)
       if (p.name == "estimator") {
         seen = true;
-        for (const char* c : {"rigid", "mc", "mc_doppler", "refined"})
+        for (const char* c : {"rigid", "mc", "mc_doppler", "refined", "keyframe"})
           EXPECT_NE(p.edit_method.find(std::string("'") + c + "'"), std::string::npos) << c;
       }
   EXPECT_TRUE(seen);
@@ -90,7 +90,7 @@ TEST(Reconfigure, CopiesByNameAndRejectsInvalid) {
   EXPECT_EQ(cfg.detector.zq, 4.5);
   EXPECT_EQ(cfg.detector.detector, "cfar");
   EXPECT_EQ(cfg.detector.max_range, 80.0);
-  EXPECT_EQ(cfg.estimator.estimator, "mc_doppler");  // untouched
+  EXPECT_EQ(cfg.estimator.estimator, spinradar::PipelineConfig{}.estimator.estimator);  // untouched
   dr.min_range = 90.0;  // >= max_range: validate() refuses, nothing is committed
   const std::string err = spinradar_ros::applyReconfigure(dr, cfg);
   EXPECT_NE(err.find("min_range"), std::string::npos) << err;

@@ -27,7 +27,7 @@
   X(int, max_keypoints, 0, 0, 100000, "", "Keep at most this many strongest keypoints (0 = all)")
 
 #define SPINRADAR_ESTIMATOR_PARAMS(X) \
-  X(std::string, estimator, "mc_doppler", 0, 0, "", "Motion estimator: rigid, mc, mc_doppler, refined or keyframe") \
+  X(std::string, estimator, "keyframe", 0, 0, "", "Motion estimator: rigid, mc, mc_doppler, refined or keyframe") \
   X(int, ransac_iterations, 100, 1, 10000, "", "RANSAC iterations") \
   X(double, inlier_threshold, 0.35, 0.01, 5.0, "m", "RANSAC inlier threshold") \
   X(int, ransac_seed, 7, 0, 1000000, "", "RANSAC random seed (fixed for reproducibility)") \
