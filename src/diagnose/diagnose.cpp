@@ -109,11 +109,22 @@ DiagnoseReport diagnoseRecording(const DiagnoseInput& in, const DiagnoseOptions&
       o.fit_az = rep.after_e_az.back()[i];
       if (!std::isfinite(o.fit_r) || !std::isfinite(o.fit_az)) continue;
     }
+    if (!with_world) {
+      // Without a world the catalogue regressors are map-aware (the mapped position moves
+      // with a parameter because the map scans were placed under it). A scan's own stretch
+      // does not move the map (map scans have their own, independent stretches), so its
+      // regressor is the direct one: the prediction's change when this scan's pose is shifted
+      // in time, d(range, azimuth)/d(body pose) * body velocity (timestamp offset +dt moves
+      // the true time by -dt).
+      const int to = static_cast<int>(Effect::TimestampOffset);
+      o.dr[to] = -(o.nr[0] * o.vx + o.nr[1] * o.vy + o.nr[2] * o.yaw_rate);
+      o.daz[to] = -(o.naz[0] * o.vx + o.naz[1] * o.vy + o.naz[2] * o.yaw_rate);
+    }
     jobs.push_back(o);
   }
   analyseJitter(jobs, rep.scans, rep.sigma_r, rep.sigma_az,
                 detail::rangeNoiseFloor(in.sensor), detail::azimuthNoiseFloor(in.sensor),
-                tau_fixed, !with_world || opt.target_nuisance, timing, opt.timing_options);
+                tau_fixed, opt.target_nuisance, timing, opt.timing_options);
   double offset = 0, offset_sd = 0;
   for (const auto& e : rep.effects)
     if (e.effect == Effect::TimestampOffset) {

@@ -90,18 +90,27 @@ void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_
   const int to = static_cast<int>(Effect::TimestampOffset);
   if (sigma_r <= 0 || sigma_az <= 0 || scans < 2) return;
   // Scans with enough returns and a usable regressor.
+  // A scan's information on its stretch is the squared norm of its whitened regressor; a scan
+  // in which the sensor stands still (stretching its firing times moves nothing) has none,
+  // and a stretch it cannot place to better than 100 % (information below 1) is left out:
+  // kept, its estimate 0 +- 0 of the minimum-norm solution pulled the spread down.
   std::vector<int> per_scan(scans, 0);
+  std::vector<double> info(scans, 0.0);
   for (const auto& o : obs)
-    if (o.scan >= 0 && o.scan < scans) ++per_scan[o.scan];
+    if (o.scan >= 0 && o.scan < scans) {
+      ++per_scan[o.scan];
+      const double tau = tau_fixed < 0 ? o.tau : tau_fixed;
+      info[o.scan] += std::pow(tau * o.dr[to] / sigma_r, 2) + std::pow(tau * o.daz[to] / sigma_az, 2);
+    }
   std::vector<int> col(scans, -1), used;
   for (int k = 0; k < scans; ++k)
-    if (per_scan[k] >= 3) {
+    if (per_scan[k] >= 3 && info[k] >= 1.0) {
       col[k] = static_cast<int>(used.size());
       used.push_back(k);
     }
   if (used.size() < 3) {
     t.notes.push_back("Rotation jitter not tested: fewer than 3 scans with 3 or more target "
-                      "returns.");
+                      "returns and a measurable stretch (sensor moving).");
     return;
   }
   std::vector<int> tcol;  // target -> first nuisance column

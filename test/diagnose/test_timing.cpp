@@ -277,11 +277,11 @@ TEST(TimingNoWorld, BurstsNamedAndNullClean) {
   EXPECT_FALSE(null.mismatch_found);
 }
 
-// Without a world the jitter is detected but its spread is underestimated: the mapped target
-// positions (refitted per target) absorb part of each scan's shift, and on the loop's straight
-// 3 m/s stretch the test scans' stretches are hardly separable (measured: 1.1 % for a realised
-// 3.3 % here, 1.4 % with motion distortion on). So this case asserts the name only, and that
-// the spread is not overstated; the report says the value is a lower bound.
+// Without a world the per-scan stretch is fitted with its direct regressor (the map does not
+// move with a test scan's own stretch) and the target positions are not refitted. On the
+// noise-free loop the peaks are quantised (shifts below a bin read as 0), so the spread comes
+// out somewhat low here (measured 0.79-0.97 of the realised std over seeds 85-88); the
+// noisy-sensor case below is the accuracy check.
 // Base and recording without motion distortion: the whole scan is rendered from the pose at
 // mid-sweep, so a stretch e_k shifts it in time by e_k * T / 2 (the tau_fixed path).
 TEST(TimingNoWorld, RotationJitterDetected) {
@@ -292,8 +292,50 @@ TEST(TimingNoWorld, RotationJitterDetected) {
   std::cout << "  realised std (test scans) " << truth << "\n";
   const TimingFinding* f = finding(rep.timing, "rotation_jitter");
   ASSERT_NE(f, nullptr);
+  EXPECT_GT(f->value, 0.7 * truth);
   EXPECT_LT(f->value, 1.15 * truth);
-  EXPECT_NE(f->evidence.find("lower bound"), std::string::npos);
+}
+
+// Issue #10: named and fitted within 15 % without a world file. Drive: longTurning() (8 m/s,
+// turns both ways), 20 scans, early-late split (map scans 2-11, test scans 12-21), noisy
+// sensor (peaks scatter by a fraction of a bin instead of being quantised). The drive ends
+// after scan 19: in the last two test scans the sensor stands still, a stretch moves nothing
+// and they are left out (7 dof). Measured ratio fitted / realised: 1.00, 1.01, 1.04, 1.08 for
+// seeds 85-88; nulls on the same drive: p 0.36, 0.12, 0.03, 0.94, no finding.
+sim::SensorConfig noisyTimingSensor() {
+  sim::SensorConfig s = smallSensor();
+  s.noise_floor_db = s.radar_constant_db - 28.0;
+  s.clutter_db = 0.0;
+  return s;
+}
+
+DiagnoseReport withoutWorldNoisy(const nlohmann::json& hidden, uint64_t seed) {
+  const sim::World world = randomWorld(seed, 90, 55.0, false);
+  DiagnoseInput in = makeInput(world, longTurning(), sim::PhysicsConfig::fromJson(hidden), 20,
+                               seed, noisyTimingSensor());
+  in.base = sim::PhysicsConfig::fromJson(kNone);
+  return diagnoseRecording(in, {}, false, "early-late");
+}
+
+TEST(TimingNoWorld, RotationJitterFittedWithin15Percent) {
+  for (uint64_t seed : {85ull, 86ull}) {
+    const DiagnoseReport rep = withoutWorldNoisy({{"rotation_jitter", 0.03}}, seed);
+    print("jitter, no world, noisy sensor", rep);
+    const double truth = realisedJitterStd(seed, 0.03, 12, 8);  // the 8 moving test scans
+    std::cout << "  realised std (moving test scans) " << truth << "\n";
+    const TimingFinding* f = finding(rep.timing, "rotation_jitter");
+    ASSERT_NE(f, nullptr) << "seed " << seed;
+    EXPECT_EQ(rep.timing.jitter_dof, 7) << "seed " << seed;
+    EXPECT_NEAR(f->value, truth, 0.15 * truth) << "seed " << seed;
+  }
+}
+
+TEST(TimingNoWorld, RotationJitterNullsClean) {
+  for (uint64_t seed : {85ull, 86ull, 87ull}) {
+    const DiagnoseReport rep = withoutWorldNoisy(kNone, seed);
+    EXPECT_TRUE(rep.timing.jitter_tested) << "seed " << seed;
+    EXPECT_FALSE(hasFinding(rep.timing, "rotation_jitter")) << "seed " << seed;
+  }
 }
 
 // ---- real samples (../shared/realdata) ----
@@ -358,3 +400,4 @@ TEST(TimingRealData, MulranBurstyBoreasRtUniform) {
 }
 
 }  // namespace
+
