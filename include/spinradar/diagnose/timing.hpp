@@ -103,8 +103,10 @@ std::vector<PolarScan> correctedStamps(const std::vector<PolarScan>& scans,
 /// `sigma_r`, `sigma_az` whiten range and azimuth residuals (re-estimated robustly, not below
 /// `floor_r`, `floor_az`: the precision of a peak fit); `tau_fixed` < 0 uses each
 /// observation's tau (motion distortion on), otherwise that time for every row (the scan is
-/// rendered from one pose). `target_nuisance`: each target's position is refitted (scene mapped
-/// from the recording). Outliers (5 robust sigmas) are set aside after the per-scan fit. Fills the jitter fields and adds a finding when significant.
+/// rendered from one pose). `target_nuisance`: each target's mean residual is removed (targets
+/// refitted as nuisance; then the spread is a lower bound). A map built from the recording
+/// does not need it: its scans have their own stretches. Outliers (5 robust sigmas) are set
+/// aside after the per-scan fit. Fills the jitter fields and adds a finding when significant.
 void analyseJitter(const std::vector<Observation>& obs, int scans, double sigma_r,
                    double sigma_az, double floor_r, double floor_az, double tau_fixed,
                    bool target_nuisance, TimingReport& timing,
