@@ -26,6 +26,7 @@ struct EvalArgs {
   std::vector<std::string> est, labels;
   std::vector<std::string> cov;
   std::string gt, plot, json;
+  std::vector<double> sensor_pose;  ///< x, y, yaw of the sensor in the truth's body frame
   int step = 10;
   int frames_listed = 20;
 };
@@ -257,7 +258,8 @@ void run(EvalArgs& a) {
   std::vector<std::string> labels = a.labels;
   if (labels.empty())
     for (const auto& e : a.est) labels.push_back(std::filesystem::path(e).stem().string());
-  const std::vector<PoseRecord> gt = readGroundTruth(a.gt);
+  std::vector<PoseRecord> gt = readGroundTruth(a.gt);
+  if (!a.sensor_pose.empty()) gt = withSensorPose(gt, a.sensor_pose[0], a.sensor_pose[1], a.sensor_pose[2]);
   KittiConfig kc;
   kc.step = a.step;
   std::vector<EvaluationReport> reports;
@@ -320,9 +322,15 @@ SPINRADAR_COMMAND(
           ->check(CLI::ExistingFile);
       app.add_option("--label", a->labels, "Name of each --est in tables and plots");
       app.add_option("--gt,-g", a->gt,
-                     "Ground truth: t,x,y,yaw CSV or the Oxford gt/radar_odometry.csv")
+                     "Ground truth: t,x,y,yaw CSV, Oxford gt/radar_odometry.csv, Boreas "
+                     "applanix/radar_poses.csv or MulRan global_pose.csv (told apart by content)")
           ->required()
           ->check(CLI::ExistingFile);
+      app.add_option("--gt-sensor-pose", a->sensor_pose,
+                     "x,y,yaw (m, m, rad): the radar's pose in the ground truth's body frame, "
+                     "when the truth is of the vehicle (MulRan global_pose.csv)")
+          ->expected(3)
+          ->delimiter(',');
       app.add_option("--covariance", a->cov,
                      "CSV of spinradar odometry --covariance-out, one per --est: adds the NEES "
                      "of the published covariances against the truth")

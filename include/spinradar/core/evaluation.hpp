@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "spinradar/core/ground_truth_io.hpp"
 #include "spinradar/core/poses_io.hpp"
 
 namespace spinradar {
@@ -119,19 +120,5 @@ EvaluationReport evaluateOdometry(const std::vector<PoseRecord>& est,
                                   const KittiConfig& config = {});
 /// Human-readable summary (drift, bins, per-frame errors for short runs).
 std::string formatReport(const EvaluationReport& report, int max_frames_listed = 20);
-
-/// Reads the Oxford Radar RobotCar `gt/radar_odometry.csv` into absolute poses, REP 103.
-/// Each row is the motion between two radar scans: the pose of the source (later) scan in the
-/// destination (earlier) scan's frame, in the dataset's x-forward, y-right, z-down frame (the
-/// SDK's interpolate_vo_poses compounds abs_k = abs_{k-1} * rel_k). Converted to REP 103 by
-/// flipping y and yaw. The first pose (identity) is stamped with the first row's
-/// destination_radar_timestamp and pose k with row k's source_radar_timestamp (the scan file
-/// names = first-azimuth stamps, the clock `spinradar odometry` writes), in seconds. Rows whose
-/// destination is not the previous row's source break the chain: error naming file and line.
-std::vector<PoseRecord> readOxfordRadarOdometry(const std::string& path);
-
-/// Ground truth of either kind, told apart by the header: Oxford radar_odometry.csv or a
-/// t,x,y,yaw CSV.
-std::vector<PoseRecord> readGroundTruth(const std::string& path);
 
 }  // namespace spinradar
