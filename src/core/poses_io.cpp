@@ -154,6 +154,13 @@ void writePoseCsv(const std::string& path, const std::vector<PoseRecord>& poses,
   if (!out) throw std::runtime_error(path + ": write failed");
 }
 
+void writeTumRow(std::ostream& out, const PoseRecord& p) {
+  char line[192];
+  std::snprintf(line, sizeof line, "%.9f %.17g %.17g 0 0 0 %.17g %.17g\n", p.t, p.x, p.y,
+                std::sin(0.5 * p.yaw), std::cos(0.5 * p.yaw));
+  out << line;
+}
+
 struct PoseCsvWriter::Impl {
   std::string path;
   std::ofstream out;

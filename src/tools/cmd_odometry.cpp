@@ -23,7 +23,7 @@ namespace {
 using namespace spinradar;
 
 struct OdometryArgs {
-  std::string input, out, format = "auto", cov_out;
+  std::string input, out, format = "auto", cov_out, tum_out;
   double range_resolution = 0.0;
   int threads = 1;
   bool quiet = false;
@@ -67,6 +67,11 @@ void run(OdometryArgs& a) {
 
   Odometry odometry(cfg);
   PoseCsvWriter writer(a.out);
+  std::ofstream tum;
+  if (!a.tum_out.empty()) {
+    tum.open(a.tum_out);
+    if (!tum) throw std::runtime_error(a.tum_out + ": cannot open for writing");
+  }
   std::ofstream cov;
   if (!a.cov_out.empty()) {
     cov.open(a.cov_out);
@@ -116,6 +121,7 @@ void run(OdometryArgs& a) {
       p.wz = r.motion.velocity(2);
     }
     writer.write(p);
+    if (tum.is_open()) writeTumRow(tum, p);
     if (cov.is_open()) {
       const Eigen::Matrix3d& K = r.T_keyframe_sensor;
       cov << p.t << ',' << (r.ok ? 1 : 0);
@@ -131,6 +137,10 @@ void run(OdometryArgs& a) {
       progress.update(i + 1, failures ? std::to_string(failures) + " failed estimate(s)" : "");
   }
   writer.close();
+  if (tum.is_open()) {
+    tum.close();
+    if (!tum) throw std::runtime_error(a.tum_out + ": write failed");
+  }
   if (cov.is_open()) {
     cov.close();
     if (!cov) throw std::runtime_error(a.cov_out + ": write failed");
@@ -170,6 +180,9 @@ SPINRADAR_COMMAND(
                      "0 = all cores")
           ->check(CLI::NonNegativeNumber);
       app.add_flag("--quiet,-q", a->quiet, "No progress line");
+      app.add_option("--tum", a->tum_out,
+                     "Also write the poses in the TUM format (t x y z qx qy qz qw) that evo "
+                     "(evo_ape, evo_rpe) and the TUM tools read");
       app.add_option("--covariance-out", a->cov_out,
                      "Also write each scan's covariances over [x, y, yaw] / [vx, vy, wz] (upper "
                      "triangles) to this CSV: accumulated pose (as published on ROS), the "

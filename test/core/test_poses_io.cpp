@@ -1,4 +1,5 @@
 // Pose CSV round trip and error messages naming file and line.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -81,4 +82,27 @@ TEST(PosesIo, ErrorsNameFileAndLine) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/poses.csv"), std::string::npos);
   }
+}
+
+// TUM line by hand: yaw 90 degrees is the quaternion (0, 0, sin 45, cos 45).
+TEST(PosesIo, TumRowByHand) {
+  PoseRecord p;
+  p.t = 1547131046.353776;
+  p.x = 2.5;
+  p.y = -1.25;
+  p.yaw = 1.5707963267948966;
+  std::ostringstream out;
+  writeTumRow(out, p);
+  std::istringstream in(out.str());
+  double t, x, y, z, qx, qy, qz, qw;
+  ASSERT_TRUE(in >> t >> x >> y >> z >> qx >> qy >> qz >> qw);
+  EXPECT_NEAR(t, 1547131046.353776, 1e-6);
+  EXPECT_EQ(x, 2.5);
+  EXPECT_EQ(y, -1.25);
+  EXPECT_EQ(z, 0.0);
+  EXPECT_EQ(qx, 0.0);
+  EXPECT_EQ(qy, 0.0);
+  EXPECT_NEAR(qz, std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(qw, std::sqrt(0.5), 1e-15);
+  EXPECT_EQ(out.str().back(), '\n');
 }

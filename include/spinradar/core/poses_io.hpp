@@ -41,6 +41,10 @@ void writePoseCsv(const std::string& path, const std::vector<PoseRecord>& poses,
 void writePoseCsv(std::ostream& out, const std::vector<PoseRecord>& poses,
                   bool with_velocity = true);
 
+/// One line of the TUM trajectory format that evo and the TUM tools read:
+/// "t x y z qx qy qz qw" (z = 0, the yaw as a quaternion about z), full precision.
+void writeTumRow(std::ostream& out, const PoseRecord& p);
+
 /// Incremental writer (the odometry tool writes as it goes so a long run leaves a usable file).
 class PoseCsvWriter {
  public:
