@@ -210,7 +210,10 @@ PolarScan loadBoreasPng(const std::string& path, double range_offset) {
       << kNavtechMetaColumns << " + 6848 bins expected (Boreas layout)";
     throw std::runtime_error(s.str());
   }
-  return decodeRows(img, path, res, range_offset, Column10::BoreasAuto);
+  PolarScan scan = decodeRows(img, path, res, range_offset, Column10::BoreasAuto);
+  if (bins == 3360 && !scan.stamp_ns.empty() && scan.stamp_ns.front() / 1000 > kBoreasUpgradeUs)
+    scan.range_resolution = 0.04381;  // same width, finer bins after the upgrade (pyboreas)
+  return scan;
 }
 
 void saveBoreasPng(const PolarScan& scan, const std::string& path) {

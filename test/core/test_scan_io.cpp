@@ -125,6 +125,10 @@ TEST(ScanIo, BoreasRoundTripBothFirmwaresAndChirps) {
     EXPECT_EQ(std::count(r.valid.begin(), r.valid.end(), 1), 400);
     EXPECT_EQ(boreasFileStampUs(r), 1606417230000000LL + 200 * 625);
   }
+  // The CIR204-H's firmware upgrade of 2021-09-21 kept 3360 bins but made them 0.04381 m.
+  PolarScan later = makeScan(400, 3360, 1634050000000000LL);
+  saveBoreasPng(later, d.file("later.png"));
+  EXPECT_DOUBLE_EQ(loadBoreasPng(d.file("later.png")).range_resolution, 0.04381);
   // Without chirps, column 10 is not read as chirps.
   PolarScan s = makeScan(400, 3360, 1606417230000000LL);
   saveBoreasPng(s, d.file("b.png"));

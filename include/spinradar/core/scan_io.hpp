@@ -42,10 +42,12 @@ PolarScan decodeOxfordImage(const cv::Mat& image, const std::string& name,
 void encodeOxfordImage(const PolarScan& scan, cv::Mat& image);
 
 // ---- Boreas (Oxford row layout) ----
-/// 3360 bins -> 0.0596 m (CIR204-H before the 2021-09-21 firmware), 6848 bins -> 0.04381 m
-/// (later firmware, Boreas-RT). Other widths are rejected. When column 10 holds both 0 and 255
+/// 3360 bins: the CIR204-H, 0.0596 m before its firmware upgrade of 2021-09-21 (Unix
+/// kBoreasUpgradeUs, told by the first azimuth's stamp as pyboreas tells it by the file name)
+/// and 0.04381 m after; 6848 bins -> 0.04381 m (Boreas-RT). Other widths are rejected. When column 10 holds both 0 and 255
 /// (Boreas-RT alternating chirps), it fills `chirp_up` instead of the valid flags.
 constexpr double kBoreasRangeOffset = -0.31;
+constexpr int64_t kBoreasUpgradeUs = 1632182400LL * 1000000;  ///< 2021-09-21 00:00 UTC
 PolarScan loadBoreasPng(const std::string& path, double range_offset = kBoreasRangeOffset);
 /// Column 10 = chirp_up ? 255 : 0 when chirp_up is present, else 255/0 valid flag.
 void saveBoreasPng(const PolarScan& scan, const std::string& path);
