@@ -35,7 +35,7 @@ double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
 KeyframeTracker::KeyframeTracker(const EstimatorConfig& config) : config_(config) {}
 
-void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d& xi,
+void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d& xi, double c,
                                    const Eigen::Matrix3d& T_w, const Eigen::Matrix3d& P) {
   // The keyframe's points as a static map: Doppler-corrected and moved to its reference
   // time with its own velocity. Headroom so that later keyframes rarely reallocate.
@@ -49,7 +49,7 @@ void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d&
     in_.reserve(c);
   }
   dopplerCorrect(f.keypoints, xi, config_.beta, tmp_kps_);
-  undistortPoints(tmp_kps_, xi, f.stamp_ns, key_pts_);
+  undistortPoints(tmp_kps_, xi, f.stamp_ns + static_cast<int64_t>(std::llround(1e9 * c)), key_pts_);
   const cv::Mat& d = f.descriptors;
   if (d.empty()) {
     key_desc_ = cv::Mat();
@@ -62,6 +62,8 @@ void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d&
   }
   T_wj_ = T_w;
   P_j_ = P;
+  key_c_ = c;
+  key_xi_ = xi;
   key_stamp_ = f.stamp_ns;
   T_jprev_.setIdentity();
   C_jprev_.setZero();
@@ -173,13 +175,16 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   const double dt = has_last_stamp_ ? 1e-9 * static_cast<double>(cur.stamp_ns - last_stamp_) : 0.25;
   last_stamp_ = cur.stamp_ns;
   has_last_stamp_ = true;
+  const double c = kMidScan * dt;  // this scan's reference: mid-scan
   if (!has_key_) {
     compound(T_w_prev, P_prev, pair.T_12, pair.T_12_cov, T_w, P);
     rel_key_stamp_ = cur.stamp_ns;
     rel_T_.setIdentity();
     rel_C_.setZero();
     key_xi_cov_ = pair.velocity_cov;
-    makeKeyframe(cur, pair.velocity, T_w, P);
+    makeKeyframe(cur, pair.velocity, c, T_w, P);
+    prev_c_ = c;
+    prev_xi_ = pair.velocity;
     return;
   }
   // The pair step assumes a smooth velocity; its covariance does not know that the yaw rate
@@ -187,12 +192,16 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   // white-noise acceleration over the step so the registration can overrule it there.
   Eigen::Matrix3d C_12 = pair.T_12_cov;
   C_12.diagonal() += stepModelNoise(dt);
+  // The step between the previous scan's mid-scan frame and this one's.
+  const Eigen::Matrix3d S =
+      se2::exp(-prev_c_ * prev_xi_) * pair.T_12 * se2::exp(c * pair.velocity);
   Eigen::Matrix3d T_odo, C_odo;
-  compound(T_jprev_, C_jprev_, pair.T_12, C_12, T_odo, C_odo);
+  compound(T_jprev_, C_jprev_, S, C_12, T_odo, C_odo);
   Eigen::Matrix3d T_jk = T_odo, C_jk = C_odo;
   // Published covariance of T_jk (see solve()); without a registration it follows the chain.
   Eigen::Matrix3d T_unused, C_pub;
-  compound(T_jprev_, C_jprev_pub_, pair.T_12, C_12, T_unused, C_pub);
+  compound(T_jprev_, C_jprev_pub_, S, C_12, T_unused, C_pub);
+  Eigen::Matrix<double, 6, 6> cov_pub = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix3d xi_cov_pub = pair.velocity_cov;
   Eigen::Vector3d xi_key = pair.velocity;  // the velocity the next keyframe is undistorted with
   const bool still = pair.velocity.isZero();
@@ -214,7 +223,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
       py_.push_back(k.y);
       ux_.push_back(std::cos(k.azimuth));
       uy_.push_back(-std::sin(k.azimuth));
-      tau_.push_back(1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns));
+      tau_.push_back(1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c);
     }
     // The pair velocity is centred about half a scan before scan k's own; within a scan the
     // yaw rate is only weakly observable (it trades against the yaw), so this prior has to
@@ -229,7 +238,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     Eigen::Matrix3d Cxi_honest = pair.velocity_cov;
     Cxi_honest.diagonal() += Eigen::Vector3d(hl * hl, hl * hl, ha * ha);
     Eigen::Vector3d xi = xi_prior;
-    Eigen::Matrix<double, 6, 6> cov, cov_pub;
+    Eigen::Matrix<double, 6, 6> cov;
     Eigen::Matrix3d T = T_odo;
     registered = solve(T_odo, C_odo, xi_prior, Cxi, Cxi_honest, T, xi, cov, cov_pub);
     if (registered) {
@@ -239,8 +248,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
       // The keyframe's own uncertainty: its points were moved to its reference time with
       // its velocity estimate, over on average half a scan, so a velocity error dxi_j moves
       // the whole map by about exp(dt/2 dxi_j) (left perturbation in the keyframe frame).
-      const double tb = 0.5 * dt;
-      C_pub = L * (cov_pub.topLeftCorner<3, 3>() + tb * tb * key_xi_cov_) * L.transpose();
+      C_pub = L * cov_pub.topLeftCorner<3, 3>() * L.transpose();
       xi_cov_pub = cov_pub.bottomRightCorner<3, 3>();
       // pair keeps the refined velocity as the published one: on the city route it is
       // closer to the truth (yaw rate 0.016 against 0.055 rad/s rms: within one scan the
@@ -248,19 +256,44 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
       xi_key = xi;
     }
   }
-  compound(T_wj_, P_j_, T_jk, C_pub, T_w, P);
+  // Back to scan-start frames for publishing: T_rel = E_j T_jk E_k^-1 (E = exp(c xi), the
+  // mid-scan frame in the scan-start one). First order in the left perturbation of T_jk
+  // (delta) and of xi_k (dxi): eps = Ad(E_j) delta - c Ad(T_rel) dxi.
+  const Eigen::Vector3d& xi_k = xi_key;
+  const Eigen::Matrix3d E_j = se2::exp(key_c_ * key_xi_);
+  const Eigen::Matrix3d T_rel = E_j * T_jk * se2::exp(-c * xi_k);
+  Eigen::Matrix3d C_rel;
+  {
+    const Eigen::Matrix3d Lm = se2::leftPerturbationToXyYaw(T_jk);
+    const Eigen::Matrix3d Lr = se2::leftPerturbationToXyYaw(T_rel);
+    Eigen::Matrix<double, 6, 6> Cd = cov_pub;
+    if (!registered) {  // only the chained pose covariance (xyYaw of T_jk) is known
+      Cd.setZero();
+      Cd.topLeftCorner<3, 3>() = Lm.inverse() * C_pub * Lm.inverse().transpose();
+    }
+    Eigen::Matrix<double, 3, 6> J;
+    J.leftCols<3>() = se2::adjoint(E_j);
+    J.rightCols<3>() = -c * se2::adjoint(T_rel);
+    // The keyframe's own uncertainty: its points were moved to its mid-scan time with its
+    // velocity estimate, so a velocity error dxi_j moves the map by about exp(c_j dxi_j).
+    const Eigen::Matrix3d Ce = J * Cd * J.transpose() + key_c_ * key_c_ * key_xi_cov_;
+    C_rel = Lr * Ce * Lr.transpose();
+  }
+  compound(T_wj_, P_j_, T_rel, C_rel, T_w, P);
   pair.T_12 = se2::inverse(T_w_prev) * T_w;
   rel_key_stamp_ = key_stamp_;
-  rel_T_ = T_jk;
-  rel_C_ = C_pub;
+  rel_T_ = T_rel;
+  rel_C_ = C_rel;
   if (registered && key_inliers_ == 0) key_inliers_ = last_inliers_;
   const double dist = T_jk.topRightCorner<2, 1>().norm();
   const double ang = std::abs(std::atan2(T_jk(1, 0), T_jk(0, 0)));
   const bool renew = (!still && !registered) || dist > kKeyframeDistance || ang > kKeyframeAngle ||
                      (registered && last_inliers_ < kInlierRatio * key_inliers_);
+  prev_c_ = c;
+  prev_xi_ = xi_k;
   if (renew) {
     key_xi_cov_ = xi_cov_pub;
-    makeKeyframe(cur, xi_key, T_w, P);
+    makeKeyframe(cur, xi_key, c, T_w, P);
   } else {
     T_jprev_ = T_jk;
     C_jprev_ = C_jk;

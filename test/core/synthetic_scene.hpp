@@ -33,6 +33,9 @@ struct SceneOptions {
   double beta = 0.0;               ///< s, injected Doppler shift: r_apparent = r - beta u
   int clutter = 0;                 ///< random keypoints per scan that match nothing
   uint32_t seed = 1;
+  /// s: velocities[k] holds over [k period + velocity_shift, (k+1) period + velocity_shift),
+  /// so that steps of the velocity fall inside a scan (0: at the scan starts).
+  double velocity_shift = 0.0;
 };
 
 /// Wraps to (-pi, pi].
@@ -53,7 +56,8 @@ class SyntheticScene {
     codes_ = cv::Mat(o.landmarks, 32, CV_8U);
     for (int i = 0; i < codes_.rows; ++i)
       for (int j = 0; j < 32; ++j) codes_.at<uint8_t>(i, j) = static_cast<uint8_t>(ub(rng_));
-    starts_.push_back(Eigen::Matrix3d::Identity());
+    // pose(0) = identity: the first segment starts at velocity_shift.
+    starts_.push_back(se2::exp(o_.velocity_shift * vel_[0]));
     for (size_t k = 0; k + 1 < vel_.size(); ++k)
       starts_.push_back(starts_.back() * se2::exp(o_.period * vel_[k]));
   }
@@ -66,16 +70,16 @@ class SyntheticScene {
   int64_t toNs(double t) const { return o_.t0_ns + static_cast<int64_t>(std::llround(t * 1e9)); }
 
   Eigen::Vector3d velocityAt(double t) const {
-    int k = static_cast<int>(std::floor(t / o_.period));
+    int k = static_cast<int>(std::floor((t - o_.velocity_shift) / o_.period));
     k = std::max(0, std::min<int>(k, static_cast<int>(vel_.size()) - 1));
     return vel_[k];
   }
 
   /// T_world_sensor(t), world = sensor frame at t0.
   Eigen::Matrix3d pose(double t) const {
-    int k = static_cast<int>(std::floor(t / o_.period));
+    int k = static_cast<int>(std::floor((t - o_.velocity_shift) / o_.period));
     k = std::max(0, std::min<int>(k, static_cast<int>(vel_.size()) - 1));
-    return starts_[k] * se2::exp((t - k * o_.period) * vel_[k]);
+    return starts_[k] * se2::exp((t - k * o_.period - o_.velocity_shift) * vel_[k]);
   }
 
   /// True relative pose T_12 between the reference frames of scans k1 and k2.
