@@ -169,6 +169,48 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
   return cov.allFinite() && cov_pub.allFinite() && T.allFinite() && xi.allFinite();
 }
 
+void KeyframeTracker::addMatch(const Eigen::Vector2d& key_pt, const Keypoint& k, double tau) {
+  qx_.push_back(key_pt.x());
+  qy_.push_back(key_pt.y());
+  px_.push_back(k.x);
+  py_.push_back(k.y);
+  ux_.push_back(std::cos(k.azimuth));
+  uy_.push_back(-std::sin(k.azimuth));
+  tau_.push_back(tau);
+}
+
+void KeyframeTracker::associateByProximity(const FeatureFrame& cur, const Eigen::Matrix3d& T_pred,
+                                           const Eigen::Vector3d& xi, double c) {
+  qx_.clear(); qy_.clear(); px_.clear(); py_.clear(); ux_.clear(); uy_.clear(); tau_.clear();
+  const size_t n = cur.keypoints.size();
+  if (qx_.capacity() < n) {  // rare: a scan with more keypoints than the keyframe's headroom
+    for (auto* v : {&qx_, &qy_, &px_, &py_, &ux_, &uy_, &tau_}) v->reserve(n + n / 2);
+    in_.reserve(n + n / 2);
+  }
+  const double gate2 = kProximityGate * kProximityGate;
+  const double beta = config_.beta;
+  for (const Keypoint& k : cur.keypoints) {
+    const double tau = 1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c;
+    const double ux = std::cos(k.azimuth), uy = -std::sin(k.azimuth);
+    const double d = beta * (ux * xi(0) + uy * xi(1));
+    const Eigen::Vector3d p(k.x + d * ux, k.y + d * uy, 1.0);
+    const Eigen::Vector2d qh = (T_pred * se2::exp(tau * xi) * p).head<2>();
+    // Brute force: this runs only on scans the descriptors could not register (a few %).
+    double best = gate2;
+    int best_j = -1;
+    for (size_t j = 0; j < key_pts_.size(); ++j) {
+      const double dx = key_pts_[j].x() - qh.x();
+      if (dx * dx >= best) continue;
+      const double dy = key_pts_[j].y() - qh.y();
+      if (dx * dx + dy * dy < best) {
+        best = dx * dx + dy * dy;
+        best_j = static_cast<int>(j);
+      }
+    }
+    if (best_j >= 0) addMatch(key_pts_[best_j], k, tau);
+  }
+}
+
 void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_prev,
                             const Eigen::Matrix3d& P_prev, double nndr, MotionEstimate& pair,
                             Eigen::Matrix3d& T_w, Eigen::Matrix3d& P) {
@@ -217,13 +259,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     qx_.clear(); qy_.clear(); px_.clear(); py_.clear(); ux_.clear(); uy_.clear(); tau_.clear();
     for (const Match& m : matches_) {
       const Keypoint& k = cur.keypoints[m.i2];
-      qx_.push_back(key_pts_[m.i1].x());
-      qy_.push_back(key_pts_[m.i1].y());
-      px_.push_back(k.x);
-      py_.push_back(k.y);
-      ux_.push_back(std::cos(k.azimuth));
-      uy_.push_back(-std::sin(k.azimuth));
-      tau_.push_back(1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c);
+      addMatch(key_pts_[m.i1], k, 1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c);
     }
     // The pair velocity is centred about half a scan before scan k's own; within a scan the
     // yaw rate is only weakly observable (it trades against the yaw), so this prior has to
@@ -241,6 +277,17 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     Eigen::Matrix<double, 6, 6> cov;
     Eigen::Matrix3d T = T_odo;
     registered = solve(T_odo, C_odo, xi_prior, Cxi, Cxi_honest, T, xi, cov, cov_pub);
+    // Descriptors failed against a keyframe turned far from this scan (ORB on the Cartesian
+    // image changes with the heading): pair keypoints by proximity to the prediction. Only
+    // there: on straights the descriptors fail for other reasons (few distinct returns) and
+    // the prediction is the better fallback. City route layouts 0-7: 0.69-0.99 % (mean
+    // 0.87 %) against 0.88-1.46 % (mean 1.08 %); tight_turns 3.9 % against 5.3 %.
+    if (!registered && std::abs(std::atan2(T_odo(1, 0), T_odo(0, 0))) > kProximityMinAngle) {
+      associateByProximity(cur, T_odo, xi_prior, c);
+      T = T_odo;
+      xi = xi_prior;
+      registered = solve(T_odo, C_odo, xi_prior, Cxi, Cxi_honest, T, xi, cov, cov_pub);
+    }
     if (registered) {
       T_jk = T;
       const Eigen::Matrix3d L = se2::leftPerturbationToXyYaw(T);

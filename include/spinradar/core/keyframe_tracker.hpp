@@ -96,6 +96,11 @@ class KeyframeTracker {
   static constexpr double kKeyframeDistance = 10.0;  ///< m, new keyframe beyond this
   static constexpr double kKeyframeAngle = 0.35;     ///< rad
   static constexpr int kMinInliers = 30;
+  /// m: when descriptor matches cannot register a scan (few and mostly wrong against a
+  /// keyframe turned by 15-30 deg at turn entry or exit), keypoints are paired with the
+  /// nearest keyframe point within this distance of the predicted position instead.
+  static constexpr double kProximityGate = 1.5;
+  static constexpr double kProximityMinAngle = 0.15;  ///< rad, keyframe-to-scan yaw for it
   static constexpr double kInlierRatio = 0.5;  ///< new keyframe below this x first count
   static constexpr double kPredictionGate = 2.0;  ///< m, first gate around the prediction
   // Prior inflation, chosen on the city route (README): velocity prior by acceleration over
@@ -154,6 +159,10 @@ class KeyframeTracker {
   std::vector<Keypoint> tmp_kps_;
   std::vector<double> qx_, qy_, px_, py_, ux_, uy_, tau_;
   std::vector<char> in_;
+  /// Fills the match arrays by proximity to the prediction (see kProximityGate).
+  void associateByProximity(const FeatureFrame& cur, const Eigen::Matrix3d& T_pred,
+                            const Eigen::Vector3d& xi, double c);
+  void addMatch(const Eigen::Vector2d& key_pt, const Keypoint& k, double tau);
 };
 
 }  // namespace spinradar
