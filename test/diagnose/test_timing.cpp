@@ -374,9 +374,11 @@ TEST(TimingRealData, OxfordStampsAreBurstsOfSixteen) {
   EXPECT_GT(t.stamp_rms_uniform, 5 * t.stamp_rms_model);
   ASSERT_TRUE(hasFinding(t, "stamp_bursts"));
   // Three scans: any scan-to-scan statement must say it is weak evidence.
-  for (const auto& f : t.findings)
-    if (f.name == "rotation_period_variation")
+  for (const auto& f : t.findings) {
+    if (f.name == "rotation_period_variation") {
       EXPECT_NE(f.evidence.find("weak evidence"), std::string::npos);
+    }
+  }
 }
 
 TEST(TimingRealData, MulranBurstyBoreasRtUniform) {
