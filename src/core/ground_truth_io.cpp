@@ -11,18 +11,6 @@ namespace spinradar {
 
 namespace {
 
-std::vector<std::string> splitComma(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  std::istringstream ss(line);
-  while (std::getline(ss, cell, ',')) {
-    size_t a = cell.find_first_not_of(" \t\r");
-    size_t b = cell.find_last_not_of(" \t\r");
-    out.push_back(a == std::string::npos ? std::string() : cell.substr(a, b - a + 1));
-  }
-  return out;
-}
-
 bool isBlank(const std::string& line) { return line.find_first_not_of(" \t\r") == std::string::npos; }
 
 /// Line-by-line reader of one CSV file whose errors name the file and the line.
@@ -37,7 +25,7 @@ class CsvLines {
     while (std::getline(in_, line)) {
       ++line_no_;
       if (isBlank(line)) continue;
-      cells = splitComma(line);
+      cells = splitCsvLine(line);
       return true;
     }
     return false;
@@ -95,7 +83,7 @@ bool isBoreasHeader(const std::string& header) { return header.rfind("GPSTime", 
 
 /// 13 bare numbers: MulRan global_pose.csv.
 bool isMulranLine(const std::string& line) {
-  const auto c = splitComma(line);
+  const auto c = splitCsvLine(line);
   if (c.size() != 13) return false;
   for (const auto& cell : c) {
     if (cell.empty()) return false;

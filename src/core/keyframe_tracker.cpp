@@ -15,21 +15,6 @@ namespace spinradar {
 
 namespace {
 
-/// T_ac = T_ab T_bc with first-order propagation over [x, y, yaw] (as Odometry::compound):
-/// p' = p + R(yaw) t, yaw' = yaw + dyaw; the two covariances independent.
-void compound(const Eigen::Matrix3d& T_ab, const Eigen::Matrix3d& P_ab, const Eigen::Matrix3d& T_bc,
-              const Eigen::Matrix3d& C_bc, Eigen::Matrix3d& T_ac, Eigen::Matrix3d& P_ac) {
-  const Eigen::Matrix2d R = T_ab.topLeftCorner<2, 2>();
-  const Eigen::Vector2d Rt = R * T_bc.topRightCorner<2, 1>();
-  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
-  F(0, 2) = -Rt.y();
-  F(1, 2) = Rt.x();
-  Eigen::Matrix3d G = Eigen::Matrix3d::Identity();
-  G.topLeftCorner<2, 2>() = R;
-  P_ac = F * P_ab * F.transpose() + G * C_bc * G.transpose();
-  T_ac = T_ab * T_bc;
-}
-
 double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
 }  // namespace
@@ -220,7 +205,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   has_last_stamp_ = true;
   const double c = kMidScan * dt;  // this scan's reference: mid-scan
   if (!has_key_) {
-    compound(T_w_prev, P_prev, pair.T_12, pair.T_12_cov, T_w, P);
+    se2::compoundXyYaw(T_w_prev, P_prev, pair.T_12, pair.T_12_cov, T_w, P);
     rel_key_stamp_ = cur.stamp_ns;
     rel_T_.setIdentity();
     rel_C_.setZero();
@@ -239,11 +224,11 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   const Eigen::Matrix3d S =
       se2::exp(-prev_c_ * prev_xi_) * pair.T_12 * se2::exp(c * pair.velocity);
   Eigen::Matrix3d T_odo, C_odo;
-  compound(T_jprev_, C_jprev_, S, C_12, T_odo, C_odo);
+  se2::compoundXyYaw(T_jprev_, C_jprev_, S, C_12, T_odo, C_odo);
   Eigen::Matrix3d T_jk = T_odo, C_jk = C_odo;
   // Published covariance of T_jk (see solve()); without a registration it follows the chain.
   Eigen::Matrix3d T_unused, C_pub;
-  compound(T_jprev_, C_jprev_pub_, S, C_12, T_unused, C_pub);
+  se2::compoundXyYaw(T_jprev_, C_jprev_pub_, S, C_12, T_unused, C_pub);
   Eigen::Matrix<double, 6, 6> cov_pub = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix3d xi_cov_pub = pair.velocity_cov;
   Eigen::Vector3d xi_key = pair.velocity;  // the velocity the next keyframe is undistorted with
@@ -334,7 +319,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     const Eigen::Matrix3d Ce = J * Cd * J.transpose() + key_c_ * key_c_ * key_xi_cov_;
     C_rel = Lr * Ce * Lr.transpose();
   }
-  compound(T_wj_, P_j_, T_rel, C_rel, T_w, P);
+  se2::compoundXyYaw(T_wj_, P_j_, T_rel, C_rel, T_w, P);
   pair.T_12 = se2::inverse(T_w_prev) * T_w;
   rel_key_stamp_ = key_stamp_;
   rel_T_ = T_rel;

@@ -224,18 +224,12 @@ struct Odometry::Impl {
     return res;
   }
 
-  /// T_world <- T_world T_12 with first-order propagation over [x, y, yaw]:
+  /// T_world <- T_world T_12 with first-order propagation over [x, y, yaw] (se2::compoundXyYaw):
   /// p' = p + R(yaw) t, yaw' = yaw + dyaw.
   void compound(const Eigen::Matrix3d& T_12, const Eigen::Matrix3d& cov_12) {
-    const Eigen::Matrix2d R = T_world.topLeftCorner<2, 2>();
-    const Eigen::Vector2d Rt = R * T_12.topRightCorner<2, 1>();
-    Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
-    F(0, 2) = -Rt.y();
-    F(1, 2) = Rt.x();
-    Eigen::Matrix3d G = Eigen::Matrix3d::Identity();
-    G.topLeftCorner<2, 2>() = R;
-    pose_cov = F * pose_cov * F.transpose() + G * cov_12 * G.transpose();
-    setPose(T_world * T_12, pose_cov);
+    Eigen::Matrix3d T, P;
+    se2::compoundXyYaw(T_world, pose_cov, T_12, cov_12, T, P);
+    setPose(T, P);
   }
 
   void setPose(const Eigen::Matrix3d& T, const Eigen::Matrix3d& P) {

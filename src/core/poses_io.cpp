@@ -24,6 +24,19 @@ Eigen::Matrix3d poseMatrix(double x, double y, double yaw) {
 
 Eigen::Matrix3d poseMatrix(const PoseRecord& p) { return poseMatrix(p.x, p.y, p.yaw); }
 
+std::vector<std::string> splitCsvLine(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cell;
+  std::istringstream ss(line);
+  while (std::getline(ss, cell, ',')) {
+    const size_t a = cell.find_first_not_of(" \t\r\n");
+    const size_t b = cell.find_last_not_of(" \t\r\n");
+    out.push_back(a == std::string::npos ? std::string() : cell.substr(a, b - a + 1));
+  }
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
 namespace {
 
 std::string trim(const std::string& s) {
@@ -31,15 +44,6 @@ std::string trim(const std::string& s) {
   if (a == std::string::npos) return {};
   size_t b = s.find_last_not_of(" \t\r\n");
   return s.substr(a, b - a + 1);
-}
-
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  std::istringstream ss(line);
-  while (std::getline(ss, cell, ',')) out.push_back(trim(cell));
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
 }
 
 [[noreturn]] void fail(const std::string& name, int line, const std::string& why) {
@@ -87,7 +91,7 @@ PoseFile readPoseCsv(std::istream& in, const std::string& name) {
     ++line_no;
     const std::string s = trim(line);
     if (s.empty() || s[0] == '#') continue;
-    const auto cells = splitCsv(s);
+    const auto cells = splitCsvLine(s);
     if (!have_header) {
       for (size_t i = 0; i < cells.size(); ++i) {
         const std::string& c = cells[i];

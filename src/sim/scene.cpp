@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "file_errors.hpp"
+#include "spinradar/core/poses_io.hpp"
 
 namespace spinradar::sim {
 
@@ -156,22 +157,6 @@ Trajectory Trajectory::fromProfile(const std::vector<Segment>& segments, const P
   return Trajectory(std::move(out));
 }
 
-namespace {
-
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cur;
-  std::istringstream ss(line);
-  while (std::getline(ss, cur, ',')) {
-    size_t a = cur.find_first_not_of(" \t\r"), b = cur.find_last_not_of(" \t\r");
-    out.push_back(a == std::string::npos ? "" : cur.substr(a, b - a + 1));
-  }
-  if (!line.empty() && line.back() == ',') out.push_back("");
-  return out;
-}
-
-}  // namespace
-
 Trajectory Trajectory::loadCsv(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");
@@ -187,7 +172,7 @@ Trajectory Trajectory::loadCsv(const std::string& path) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     size_t first = line.find_first_not_of(" \t");
     if (first == std::string::npos || line[first] == '#') continue;
-    auto f = splitCsv(line);
+    auto f = splitCsvLine(line);
     if (!header) {
       for (size_t c = 0; c < f.size(); ++c)
         for (int k = 0; k < 4; ++k)

@@ -293,7 +293,9 @@ TEST(KeyframeTracker, SwitchingEstimatorsKeepsThePoseContinuous) {
       odo.setConfig(cfg);
     }
     res = odo.process(scene.observe(k));
-    if (k > 0) EXPECT_TRUE(res.ok) << k;
+    if (k > 0) {
+      EXPECT_TRUE(res.ok) << k;
+    }
   }
   const Eigen::Matrix3d truth = scene.pose(scene.scanStart(17));
   EXPECT_LT((res.T_world_sensor.topRightCorner<2, 1>() - truth.topRightCorner<2, 1>()).norm(), 0.1);

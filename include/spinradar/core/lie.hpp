@@ -176,6 +176,22 @@ inline Mat3 leftPerturbationToXyYaw(const Mat3& T) {
   return L;
 }
 
+/// T_ac = T_ab T_bc with first-order propagation of independent covariances over
+/// [x, y, yaw]: p' = p + R(yaw) t, yaw' = yaw + dyaw. P_ac may alias P_ab.
+inline void compoundXyYaw(const Mat3& T_ab, const Mat3& P_ab, const Mat3& T_bc, const Mat3& C_bc,
+                          Mat3& T_ac, Mat3& P_ac) {
+  const Eigen::Matrix2d R = T_ab.topLeftCorner<2, 2>();
+  const Eigen::Vector2d Rt = R * T_bc.topRightCorner<2, 1>();
+  Mat3 F = Mat3::Identity();
+  F(0, 2) = -Rt.y();
+  F(1, 2) = Rt.x();
+  Mat3 G = Mat3::Identity();
+  G.topLeftCorner<2, 2>() = R;
+  const Mat3 P = F * P_ab * F.transpose() + G * C_bc * G.transpose();
+  T_ac = T_ab * T_bc;
+  P_ac = P;
+}
+
 }  // namespace se2
 
 // ----------------------------------------------------------------------------------------

@@ -17,6 +17,10 @@ struct PoseRecord {
   double vx = 0.0, vy = 0.0, wz = 0.0;
 };
 
+/// One CSV line split at commas, each cell trimmed of blanks; a trailing comma gives a last,
+/// empty cell (so column counts stay honest). No quoting: the project's files need none.
+std::vector<std::string> splitCsvLine(const std::string& line);
+
 /// Pose as an SE(2) matrix T_world_sensor.
 Eigen::Matrix3d poseMatrix(double x, double y, double yaw);
 Eigen::Matrix3d poseMatrix(const PoseRecord& p);
