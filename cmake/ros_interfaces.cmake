@@ -20,7 +20,7 @@ endif()
 
 catkin_package(
   INCLUDE_DIRS include
-  LIBRARIES spinradar_core
+  LIBRARIES ${SPINRADAR_ALL_PARTS}
   CATKIN_DEPENDS roscpp nodelet pluginlib std_msgs sensor_msgs geometry_msgs nav_msgs tf2_ros
     dynamic_reconfigure message_runtime
 )

@@ -6,10 +6,10 @@ if(SPINRADAR_ROS_SOURCES OR SPINRADAR_NODELET_SOURCES)
   add_library(spinradar_nodelets SHARED ${SPINRADAR_ROS_SOURCES} ${SPINRADAR_NODELET_SOURCES})
   target_include_directories(spinradar_nodelets PUBLIC ${PROJECT_SOURCE_DIR}/include
     ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION} ${catkin_INCLUDE_DIRS})
-  target_link_libraries(spinradar_nodelets PUBLIC spinradar_core ${catkin_LIBRARIES})
-  if(TARGET spinradar_sim)
-    target_link_libraries(spinradar_nodelets PUBLIC spinradar_sim)
-  endif()
+  # The ROS shell sits on the driver, estimation, localization and the simulator's live input.
+  target_link_libraries(spinradar_nodelets PUBLIC spinradar_driver spinradar_estimation
+    spinradar_localization spinradar_sim spinradar_io spinradar_evaluation spinradar_core
+    ${catkin_LIBRARIES})
   add_dependencies(spinradar_nodelets ${PROJECT_NAME}_generate_messages_cpp ${PROJECT_NAME}_gencfg)
 endif()
 

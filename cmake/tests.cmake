@@ -26,14 +26,23 @@ function(spinradar_add_tests module)
   endforeach()
 endfunction()
 
-spinradar_add_tests(core spinradar_core)
-if(TARGET spinradar_sim)
-  spinradar_add_tests(sim spinradar_sim spinradar_core)
-endif()
-if(TARGET spinradar_diagnose)
-  spinradar_add_tests(diagnose spinradar_diagnose spinradar_sim spinradar_core)
-endif()
+# Tests live with their part (test/<part>/) and link that part's library (and test helpers
+# from test/support/ by include path).
+foreach(part core driver io features estimation evaluation localization)
+  spinradar_add_tests(${part} spinradar_${part})
+endforeach()
+# The simulator's and the diagnosis's tests run the whole pipeline on simulated recordings.
+spinradar_add_tests(sim ${SPINRADAR_ALL_PARTS})
+spinradar_add_tests(diagnose ${SPINRADAR_ALL_PARTS})
 file(GLOB SPINRADAR_EXTRA_TEST_CMAKE CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/test/*.cmake)
 foreach(f ${SPINRADAR_EXTRA_TEST_CMAKE})
   include(${f})
 endforeach()
+# test_keypoint_truth compiles the CLI's option parser in (pipeline_options.cpp).
+if(TARGET sim_test_keypoint_truth)
+  target_link_libraries(sim_test_keypoint_truth PRIVATE yaml-cpp CLI11::CLI11)
+endif()
+# Tests that feed one part with another's output (real scans read by io into the driver).
+target_link_libraries(driver_test_navtech_realdata PRIVATE spinradar_io)
+target_link_libraries(io_test_ground_truth_io PRIVATE spinradar_evaluation)
+target_link_libraries(features_test_feature_extractor PRIVATE spinradar_io)

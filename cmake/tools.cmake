@@ -9,7 +9,7 @@ if(SPINRADAR_ROS AND SPINRADAR_BAG_SOURCES AND EXISTS ${SPINRADAR_BAG_CONVERSION
   add_library(spinradar_bag SHARED ${SPINRADAR_BAG_SOURCES})
   target_include_directories(spinradar_bag PUBLIC ${PROJECT_SOURCE_DIR}/src/bag
     ${CATKIN_DEVEL_PREFIX}/include ${catkin_INCLUDE_DIRS})
-  target_link_libraries(spinradar_bag PUBLIC spinradar_core ${catkin_LIBRARIES})
+  target_link_libraries(spinradar_bag PUBLIC spinradar_io spinradar_core ${catkin_LIBRARIES})
   # Conversions implemented in src/ros/ are part of the nodelet library (defined later; CMake
   # resolves the name at generation time).
   file(GLOB SPINRADAR_BAG_CONV_SRC CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/ros/*conversions*.cpp)
@@ -28,10 +28,10 @@ if(SPINRADAR_TOOL_SOURCES)
   add_executable(spinradar_cli ${SPINRADAR_TOOL_SOURCES})
   set_target_properties(spinradar_cli PROPERTIES OUTPUT_NAME spinradar
     RUNTIME_OUTPUT_DIRECTORY ${SPINRADAR_BIN_DIR})
-  target_link_libraries(spinradar_cli PRIVATE spinradar_core CLI11::CLI11)
+  target_link_libraries(spinradar_cli PRIVATE ${SPINRADAR_ALL_PARTS} CLI11::CLI11 yaml-cpp)
   target_include_directories(spinradar_cli PRIVATE ${PROJECT_SOURCE_DIR}/src/tools
     ${PROJECT_SOURCE_DIR}/src/bag)
-  foreach(lib spinradar_sim spinradar_diagnose spinradar_bag)
+  foreach(lib spinradar_bag)
     if(TARGET ${lib})
       target_link_libraries(spinradar_cli PRIVATE ${lib})
     endif()

@@ -13,7 +13,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 
-#include "spinradar/core/navtech_driver.hpp"
+#include "spinradar/driver/navtech_driver.hpp"
 #include "spinradar/sim/sim_radar_input.hpp"
 #include "spinradar_ros/params.hpp"
 #include "spinradar_ros/polar_scan_conversions.hpp"

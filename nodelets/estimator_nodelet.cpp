@@ -13,7 +13,7 @@
 
 #include <spinradar/EstimatorNodeletConfig.h>
 
-#include "spinradar/core/odometry.hpp"
+#include "spinradar/estimation/odometry.hpp"
 #include "spinradar_ros/conversions.hpp"
 #include "spinradar_ros/params.hpp"
 #include "spinradar_ros/validated_reconfigure.hpp"

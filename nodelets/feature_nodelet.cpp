@@ -10,7 +10,7 @@
 
 #include <spinradar/FeatureNodeletConfig.h>
 
-#include "spinradar/core/feature_extractor.hpp"
+#include "spinradar/features/feature_extractor.hpp"
 #include "spinradar_ros/conversions.hpp"
 #include "spinradar_ros/params.hpp"
 #include "spinradar_ros/validated_reconfigure.hpp"

@@ -1,6 +1,6 @@
 // Localizer nodelet: metric localization of the live polar scans (spinradar/RadarScan on `scan`)
 // against a map drive loaded once (`map_dir` scans, `map_poses` t,x,y,yaw CSV of the radar in
-// the map), RSD descriptors and compensated RANSAC (spinradar/core/localizer.hpp). The
+// the map), RSD descriptors and compensated RANSAC (spinradar/localization/localizer.hpp). The
 // estimator's `odom` supplies each scan's velocity and the odom pose at the scan time; out:
 // tf map -> odom. Results wait for the odometry of their scan (the estimator runs after the
 // feature nodelet, so it lags the scan).
@@ -15,7 +15,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
-#include "spinradar/core/localizer.hpp"
+#include "spinradar/localization/localizer.hpp"
 #include "spinradar_ros/conversions.hpp"
 #include "spinradar_ros/map_odom.hpp"
 #include "spinradar_ros/params.hpp"

@@ -4,7 +4,7 @@
 Each row of radar_odometry.csv is the SE(2) motion from destination_radar_timestamp to
 source_radar_timestamp in the dataset's frame (x forward, y right, yaw clockwise). The rows are
 chained from the first destination stamp (pose 0 = origin) exactly as
-readOxfordRadarOdometry in src/core/evaluation.cpp does, and converted to REP 103 by
+readOxfordRadarOdometry in src/evaluation/evaluation.cpp does, and converted to REP 103 by
 conjugating with diag(1, -1). Stamps are microseconds in, seconds out.
 
 Usage: oxford_gt_to_trajectory.py radar_odometry.csv out.csv

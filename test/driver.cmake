@@ -21,13 +21,13 @@ if(SPINRADAR_FUZZ_OK)
   file(MAKE_DIRECTORY ${CMAKE_BINARY_DIR}/fuzz)
   set(fuzz_srcs
     ${PROJECT_SOURCE_DIR}/test/fuzz/fuzz_navtech_stream.cpp
-    ${PROJECT_SOURCE_DIR}/src/core/navtech_protocol.cpp
-    ${PROJECT_SOURCE_DIR}/src/core/navtech_time.cpp
-    ${PROJECT_SOURCE_DIR}/src/core/scan_assembler.cpp)
+    ${PROJECT_SOURCE_DIR}/src/driver/navtech_protocol.cpp
+    ${PROJECT_SOURCE_DIR}/src/driver/navtech_time.cpp
+    ${PROJECT_SOURCE_DIR}/src/driver/scan_assembler.cpp)
   set(fuzz_hdrs
-    ${PROJECT_SOURCE_DIR}/include/spinradar/core/navtech_protocol.hpp
-    ${PROJECT_SOURCE_DIR}/include/spinradar/core/navtech_time.hpp
-    ${PROJECT_SOURCE_DIR}/include/spinradar/core/scan_assembler.hpp
+    ${PROJECT_SOURCE_DIR}/include/spinradar/driver/navtech_protocol.hpp
+    ${PROJECT_SOURCE_DIR}/include/spinradar/driver/navtech_time.hpp
+    ${PROJECT_SOURCE_DIR}/include/spinradar/driver/scan_assembler.hpp
     ${PROJECT_SOURCE_DIR}/include/spinradar/core/polar_scan.hpp)
   add_custom_command(OUTPUT ${fuzz_bin}
     COMMAND ${SPINRADAR_CLANGXX} -std=c++17 -g -O1 -fsanitize=fuzzer,address,undefined

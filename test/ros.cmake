@@ -4,7 +4,7 @@ if(SPINRADAR_ROS)
   add_executable(ros_test_glue test/ros/test_ros_glue.cpp src/ros/conversions.cpp)
   target_include_directories(ros_test_glue PRIVATE ${PROJECT_SOURCE_DIR}/include
     ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION} ${catkin_INCLUDE_DIRS})
-  target_link_libraries(ros_test_glue PRIVATE spinradar_core ${catkin_LIBRARIES} ${SPINRADAR_GTEST}
+  target_link_libraries(ros_test_glue PRIVATE ${SPINRADAR_ALL_PARTS} ${catkin_LIBRARIES} ${SPINRADAR_GTEST}
     Threads::Threads)
   add_dependencies(ros_test_glue ${PROJECT_NAME}_generate_messages_cpp ${PROJECT_NAME}_gencfg)
   gtest_discover_tests(ros_test_glue DISCOVERY_MODE PRE_TEST TEST_PREFIX "ros." PROPERTIES TIMEOUT 60)
@@ -13,7 +13,7 @@ if(SPINRADAR_ROS)
   if(TARGET spinradar_sim)
     add_executable(ros_test_map_localization test/ros/test_map_localization.cpp)
     target_include_directories(ros_test_map_localization PRIVATE ${PROJECT_SOURCE_DIR}/include)
-    target_link_libraries(ros_test_map_localization PRIVATE spinradar_sim spinradar_core
+    target_link_libraries(ros_test_map_localization PRIVATE ${SPINRADAR_ALL_PARTS}
       ${SPINRADAR_GTEST} Threads::Threads)
     gtest_discover_tests(ros_test_map_localization DISCOVERY_MODE PRE_TEST TEST_PREFIX "ros."
       PROPERTIES TIMEOUT 60)
@@ -33,7 +33,7 @@ if(SPINRADAR_ROS AND rostest_FOUND AND CATKIN_ENABLE_TESTING AND TARGET spinrada
     add_executable(ros_test_${t} test/ros/test_${t}.cpp)
     target_include_directories(ros_test_${t} PRIVATE ${PROJECT_SOURCE_DIR}/include
       ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION} ${catkin_INCLUDE_DIRS})
-    target_link_libraries(ros_test_${t} PRIVATE spinradar_sim spinradar_core ${catkin_LIBRARIES}
+    target_link_libraries(ros_test_${t} PRIVATE ${SPINRADAR_ALL_PARTS} ${catkin_LIBRARIES}
       ${SPINRADAR_GTEST} Threads::Threads)
     add_dependencies(ros_test_${t} ${PROJECT_NAME}_generate_messages_cpp)
   endforeach()

@@ -17,7 +17,7 @@
 #include <spinradar/Features.h>
 
 #include "spinradar/core/feature_frame.hpp"
-#include "spinradar/core/odometry.hpp"
+#include "spinradar/estimation/odometry.hpp"
 
 namespace spinradar_ros {
 

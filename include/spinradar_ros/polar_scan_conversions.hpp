@@ -10,7 +10,7 @@
 #include <spinradar/RadarScan.h>
 
 #include "spinradar/core/polar_scan.hpp"
-#include "spinradar/core/scan_assembler.hpp"
+#include "spinradar/driver/scan_assembler.hpp"
 
 namespace spinradar_ros {
 

@@ -12,7 +12,7 @@
 #include <rosbag/view.h>
 #include <spinradar/RadarScan.h>
 
-#include "spinradar/core/scan_io.hpp"
+#include "spinradar/io/scan_io.hpp"
 #include "spinradar_ros/polar_scan_conversions.hpp"
 
 namespace spinradar::bag {

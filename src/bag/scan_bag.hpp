@@ -6,7 +6,7 @@
 #include <functional>
 #include <string>
 
-#include "spinradar/core/scan_folder.hpp"
+#include "spinradar/io/scan_folder.hpp"
 
 namespace spinradar::bag {
 

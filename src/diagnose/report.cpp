@@ -5,7 +5,7 @@
 #include <iomanip>
 #include <sstream>
 
-#include "spinradar/core/plot.hpp"
+#include "spinradar/evaluation/plot.hpp"
 #include "spinradar/diagnose/advice.hpp"
 #include "spinradar/diagnose/diagnose.hpp"
 

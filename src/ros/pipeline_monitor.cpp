@@ -21,8 +21,8 @@
 #include <spinradar/Features.h>
 #include <spinradar/RadarScan.h>
 
-#include "spinradar/core/evaluation.hpp"
-#include "spinradar/core/poses_io.hpp"
+#include "spinradar/evaluation/evaluation.hpp"
+#include "spinradar/io/poses_io.hpp"
 #include "spinradar_ros/conversions.hpp"
 
 namespace spinradar_ros {

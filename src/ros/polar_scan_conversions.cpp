@@ -6,7 +6,7 @@
 
 #include <opencv2/core/mat.hpp>
 
-#include "spinradar/core/scan_io.hpp"
+#include "spinradar/io/scan_io.hpp"
 
 namespace spinradar_ros {
 

@@ -7,8 +7,8 @@
 #include <iomanip>
 #include <sstream>
 
-#include "spinradar/core/detector.hpp"
-#include "spinradar/core/scan_io.hpp"
+#include "spinradar/features/detector.hpp"
+#include "spinradar/io/scan_io.hpp"
 
 namespace spinradar::sim {
 

@@ -9,7 +9,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "spinradar/core/scan_io.hpp"
+#include "spinradar/io/scan_io.hpp"
 #include "spinradar/sim/simulator.hpp"
 
 namespace spinradar::sim {

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "file_errors.hpp"
-#include "spinradar/core/poses_io.hpp"
+#include "spinradar/io/poses_io.hpp"
 
 namespace spinradar::sim {
 

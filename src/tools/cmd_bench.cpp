@@ -17,10 +17,10 @@
 
 #include "command.hpp"
 #include "pipeline_options.hpp"
-#include "spinradar/core/feature_extractor.hpp"
-#include "spinradar/core/matcher.hpp"
-#include "spinradar/core/odometry.hpp"
-#include "spinradar/core/scan_folder.hpp"
+#include "spinradar/features/feature_extractor.hpp"
+#include "spinradar/features/matcher.hpp"
+#include "spinradar/estimation/odometry.hpp"
+#include "spinradar/io/scan_folder.hpp"
 #ifdef SPINRADAR_HAVE_SIM
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"

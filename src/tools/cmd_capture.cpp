@@ -10,8 +10,8 @@
 #include <iostream>
 
 #include "command.hpp"
-#include "spinradar/core/navtech_driver.hpp"
-#include "spinradar/core/scan_io.hpp"
+#include "spinradar/driver/navtech_driver.hpp"
+#include "spinradar/io/scan_io.hpp"
 
 namespace {
 

@@ -11,8 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "spinradar/core/scan_folder.hpp"
-#include "spinradar/core/scan_io.hpp"
+#include "spinradar/io/scan_folder.hpp"
+#include "spinradar/io/scan_io.hpp"
 #include "spinradar/diagnose/chirp_doppler.hpp"
 
 namespace {

@@ -5,7 +5,7 @@
 #include <memory>
 
 #include "command.hpp"
-#include "spinradar/core/scan_folder.hpp"
+#include "spinradar/io/scan_folder.hpp"
 #include "spinradar/diagnose/chirp_doppler.hpp"
 #include "spinradar/diagnose/diagnose.hpp"
 #ifdef SPINRADAR_HAVE_BAG

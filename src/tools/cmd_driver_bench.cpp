@@ -11,8 +11,8 @@
 #include <sstream>
 
 #include "command.hpp"
-#include "spinradar/core/navtech_driver.hpp"
-#include "spinradar/core/navtech_server.hpp"
+#include "spinradar/driver/navtech_driver.hpp"
+#include "spinradar/driver/navtech_server.hpp"
 
 namespace {
 

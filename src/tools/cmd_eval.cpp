@@ -14,9 +14,9 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "spinradar/core/evaluation.hpp"
+#include "spinradar/evaluation/evaluation.hpp"
 #include "spinradar/core/lie.hpp"
-#include "spinradar/core/plot.hpp"
+#include "spinradar/evaluation/plot.hpp"
 
 namespace {
 

@@ -15,11 +15,11 @@
 #include "command.hpp"
 #include "pipeline_options.hpp"
 #include "progress.hpp"
-#include "spinradar/core/evaluation.hpp"
+#include "spinradar/evaluation/evaluation.hpp"
 #include "spinradar/core/lie.hpp"
-#include "spinradar/core/localizer.hpp"
-#include "spinradar/core/plot.hpp"
-#include "spinradar/core/scan_folder.hpp"
+#include "spinradar/localization/localizer.hpp"
+#include "spinradar/evaluation/plot.hpp"
+#include "spinradar/io/scan_folder.hpp"
 
 namespace {
 

@@ -14,9 +14,9 @@
 #include "command.hpp"
 #include "pipeline_options.hpp"
 #include "progress.hpp"
-#include "spinradar/core/odometry.hpp"
-#include "spinradar/core/poses_io.hpp"
-#include "spinradar/core/scan_folder.hpp"
+#include "spinradar/estimation/odometry.hpp"
+#include "spinradar/io/poses_io.hpp"
+#include "spinradar/io/scan_folder.hpp"
 
 namespace {
 

@@ -4,10 +4,10 @@
 #include <type_traits>
 
 #include "command.hpp"
-#include "spinradar/core/driver_config.hpp"
-#include "spinradar/core/localizer.hpp"
+#include "spinradar/driver/driver_config.hpp"
+#include "spinradar/localization/localizer.hpp"
 #include "spinradar/core/params.hpp"
-#include "spinradar/core/rsd.hpp"
+#include "spinradar/localization/rsd.hpp"
 #include "spinradar/sim/sensor_config.hpp"
 
 namespace {

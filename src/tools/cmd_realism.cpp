@@ -2,7 +2,7 @@
 #include <iostream>
 
 #include "command.hpp"
-#include "spinradar/core/scan_folder.hpp"
+#include "spinradar/io/scan_folder.hpp"
 #include "spinradar/sim/realism.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"

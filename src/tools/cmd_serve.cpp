@@ -8,7 +8,7 @@
 #include <thread>
 
 #include "command.hpp"
-#include "spinradar/core/navtech_server.hpp"
+#include "spinradar/driver/navtech_server.hpp"
 #include "spinradar/sim/physics.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/sim_radar_input.hpp"

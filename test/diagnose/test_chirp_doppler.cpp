@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "spinradar/core/scan_io.hpp"
+#include "spinradar/io/scan_io.hpp"
 #include "spinradar/diagnose/chirp_doppler.hpp"
 #include "spinradar/sim/simulator.hpp"
 

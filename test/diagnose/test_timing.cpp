@@ -11,8 +11,8 @@
 
 #include "../../src/sim/render_model.hpp"  // the simulator's RNG: realised per-scan stretches
 #include "diagnose/diagnose_fixtures.hpp"
-#include "spinradar/core/scan_folder.hpp"
-#include "spinradar/core/scan_io.hpp"
+#include "spinradar/io/scan_folder.hpp"
+#include "spinradar/io/scan_io.hpp"
 
 using namespace spinradar;
 using namespace spinradar::diagnose;

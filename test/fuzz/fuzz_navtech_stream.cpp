@@ -4,9 +4,9 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "spinradar/core/navtech_protocol.hpp"
-#include "spinradar/core/navtech_time.hpp"
-#include "spinradar/core/scan_assembler.hpp"
+#include "spinradar/driver/navtech_protocol.hpp"
+#include "spinradar/driver/navtech_time.hpp"
+#include "spinradar/driver/scan_assembler.hpp"
 
 using namespace spinradar::navtech;
 

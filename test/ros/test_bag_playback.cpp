@@ -10,7 +10,7 @@
 #include <ros/ros.h>
 
 #include "spinradar/core/lie.hpp"
-#include "spinradar/core/poses_io.hpp"
+#include "spinradar/io/poses_io.hpp"
 
 namespace {
 

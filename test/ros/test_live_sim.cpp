@@ -19,9 +19,9 @@
 #include <spinradar/RadarScan.h>
 
 #include "cloud_alignment.hpp"
-#include "spinradar/core/evaluation.hpp"
+#include "spinradar/evaluation/evaluation.hpp"
 #include "spinradar/core/lie.hpp"
-#include "spinradar/core/poses_io.hpp"
+#include "spinradar/io/poses_io.hpp"
 #include "spinradar/sim/scenes.hpp"
 
 namespace {

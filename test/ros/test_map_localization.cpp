@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "spinradar/core/lie.hpp"
-#include "spinradar/core/localizer.hpp"
+#include "spinradar/localization/localizer.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
 #include "spinradar_ros/map_odom.hpp"

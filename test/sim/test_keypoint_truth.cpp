@@ -13,10 +13,10 @@
 #include <random>
 
 #include "sim_test_util.hpp"
-#include "spinradar/core/detector.hpp"
-#include "spinradar/core/feature_extractor.hpp"
-#include "spinradar/core/matcher.hpp"
-#include "spinradar/core/mc_ransac.hpp"
+#include "spinradar/features/detector.hpp"
+#include "spinradar/features/feature_extractor.hpp"
+#include "spinradar/features/matcher.hpp"
+#include "spinradar/estimation/mc_ransac.hpp"
 // The CLI's option layer is not a library; compiled in here so that the test goes through the
 // same `--azimuth-peaks` / YAML path as `spinradar odometry`.
 #include "../../src/tools/pipeline_options.cpp"

@@ -2,7 +2,7 @@
 // and the assembler, and come out identical to the simulator's own rendering.
 #include <gtest/gtest.h>
 
-#include "spinradar/core/navtech_driver.hpp"
+#include "spinradar/driver/navtech_driver.hpp"
 #include "spinradar/sim/sim_radar_input.hpp"
 
 using namespace spinradar;

@@ -5,7 +5,7 @@
 #include <thread>
 
 #include "sim_test_util.hpp"
-#include "spinradar/core/scan_io.hpp"
+#include "spinradar/io/scan_io.hpp"
 #include "spinradar/sim/realism.hpp"
 #include "spinradar/sim/scenes.hpp"
 

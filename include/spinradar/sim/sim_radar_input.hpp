@@ -6,8 +6,8 @@
 #include <memory>
 #include <string>
 
-#include "spinradar/core/navtech_server.hpp"
-#include "spinradar/core/radar_input.hpp"
+#include "spinradar/driver/navtech_server.hpp"
+#include "spinradar/driver/radar_input.hpp"
 #include "spinradar/sim/simulator.hpp"
 
 namespace spinradar::sim {

@@ -1,0 +1,28 @@
+# One shared library per part of the product, each linking only the parts it uses. The
+# allowed directions are written down in docs/DEVELOPING.md ("Parts and what each may use")
+# and checked by test/core/test_layering.cpp; keep the `USES` lists below in step with it.
+# Sources are globbed: adding src/<part>/foo.cpp adds it to spinradar_<part>.
+function(spinradar_part part)
+  cmake_parse_arguments(P "" "" "USES;LIBS" ${ARGN})
+  file(GLOB srcs CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/${part}/*.cpp)
+  add_library(spinradar_${part} SHARED ${srcs})
+  target_include_directories(spinradar_${part} PUBLIC ${PROJECT_SOURCE_DIR}/include)
+  foreach(u ${P_USES})
+    target_link_libraries(spinradar_${part} PUBLIC spinradar_${u})
+  endforeach()
+  target_link_libraries(spinradar_${part} PUBLIC ${P_LIBS})
+  target_compile_options(spinradar_${part} PRIVATE -O3 -march=x86-64-v2)
+endfunction()
+
+spinradar_part(core                       LIBS Eigen3::Eigen opencv_core)
+spinradar_part(driver       USES core     LIBS Threads::Threads)
+spinradar_part(io           USES core     LIBS opencv_imgcodecs)
+spinradar_part(features     USES core     LIBS opencv_features2d opencv_imgproc)
+spinradar_part(estimation   USES features core)
+spinradar_part(evaluation   USES io core  LIBS opencv_imgproc opencv_imgcodecs)
+spinradar_part(localization USES estimation features evaluation io core)
+spinradar_part(sim          USES driver io features evaluation core
+                            LIBS nlohmann_json::nlohmann_json TBB::tbb Threads::Threads)
+spinradar_part(diagnose     USES sim evaluation io features core LIBS nlohmann_json::nlohmann_json)
+target_include_directories(spinradar_core PUBLIC ${OpenCV_INCLUDE_DIRS})
+

@@ -1,0 +1,168 @@
+#pragma once
+// The `keyframe` estimator (issue 9): the refined frame-to-frame estimate as a motion prior,
+// then every scan registered directly against a keyframe (an earlier scan, undistorted and
+// Doppler-corrected with its own velocity: a small static local map).
+//
+// Why (measured on the simulator's city route with full physics, see the README): the
+// frame-to-frame estimators' heading is a random walk of ~0.06 deg per scan, which alone
+// gives ~0.7 % translational drift over 100..800 m. Registering each scan to a keyframe
+// several scans back measures the pose relative to the keyframe directly, so the walk
+// advances once per keyframe instead of once per scan.
+//
+// Per scan, a Gauss-Newton solve over the 6-vector [pose T_jk (left perturbation; mid-scan
+// frames, see below), body velocity xi_k during scan k]:
+//   keyframe matches  e_m = q_m - T_jk exp(tau_m xi_k^) (p_m + beta (u_m . v_k) u_m)
+//                     (each keypoint at its own time tau_m = t_m - t_k - c, Doppler with the
+//                     velocity being estimated), weight (R_cart(q) + C R_cart(p) C^T)^-1,
+//                     gated around the prediction, then at inlier_threshold (moving cars
+//                     and wrong matches fall out),
+//   pose prior        T_jk ~ T_j,k-1 T_12 (the refined pair step), its covariance: along a
+//                     street of repetitive facades the registration is degenerate along
+//                     track and the prior holds that direction instead of jumping,
+//   velocity prior    xi_k ~ refined pair velocity, inflated for its half-scan lag.
+// Standing still (refined velocity snapped to zero) holds the pose.
+// Covariance: the published one (pose relative to the keyframe, compounded onto the
+// keyframe's world pose) is computed apart from the one that chains into the next prior,
+// which stays as tuned for drift: it leaves out the pose prior (not independent of the
+// registration: same keyframe points), inflates the velocity prior for its real half-scan
+// lag, scales by chi2/dof both ways and adds the keyframe map's own uncertainty (its points
+// were undistorted with its velocity estimate), and the extrapolation from mid-scan to the
+// scan start. Mean NEES of the published pose relative to the keyframe, city route with
+// full physics, layouts 0-3: 3.31 / 3.17 / 2.42 / 3.83 (95 % bound covers 94.1-95.5 %;
+// 5.2-6.1 and 84-89 % with the scan-start reference).
+// Mid-scan reference (turn entry and exit): the registration measures the pose at the mean
+// time of the scan's points well, the yaw rate within a scan only weakly (it trades against
+// the yaw). So poses are solved, chained and kept for keyframes (their maps undistorted to
+// that time) at mid-scan, t_k + kMidScan * period, and only the published scan-start pose
+// is extrapolated back with exp(-c xi_k). Where the yaw rate steps (0 -> 0.625 rad/s within
+// one scan on the city route) the velocity prior is wrong for that scan; with a scan-start
+// reference that error (c * dw, ~1-2 deg) went into the keyframe chain, now it stays in the
+// one published pose. City route, full physics, layouts 0-3, 3 runs each (runs differ by a
+// 0.5-1 ms shift of the reference, which alone moves layout 0 between 0.77 and 1.10 %):
+// translational drift 1.018 -> 0.974 %, rotational 0.00368 -> 0.00358 deg/m (issue 9).
+// Tried and measured worse (same runs): a constant-acceleration model within the scan
+// (9 states; layout 2: 1.17 -> 2.2 %), a free yaw rate to detect steps (unreliable on
+// straight streets), a keyframe held one scan and re-registered with the next scan's pose
+// (mean of layouts 0-3: 1.48 %), its map rebuilt with the velocity ramping between the pair
+// velocities at its start and end (1.13 %), against 0.97-1.02 % without either.
+// A new keyframe is taken when the current one is far (distance, angle), when the
+// registration keeps too few inliers, or when it fails (then the pose is the prior).
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include "spinradar/core/feature_frame.hpp"
+#include "spinradar/features/matcher.hpp"
+#include "spinradar/estimation/motion_estimate.hpp"
+#include "spinradar/core/params.hpp"
+
+namespace spinradar {
+
+class KeyframeTracker {
+ public:
+  explicit KeyframeTracker(const EstimatorConfig& config = EstimatorConfig{});
+  void setConfig(const EstimatorConfig& config) { config_ = config; }
+  void reset() { has_key_ = has_last_stamp_ = false; }
+
+  /// cur: the newest scan (raw keypoints and descriptors). pair: the frame-to-frame estimate
+  /// from the previous scan to cur (ok); T_12 is updated in place to the step actually taken
+  /// (velocity and velocity_cov stay the refined pair's: published, see the .cpp).
+  /// T_w_prev, P_prev: pose of the previous scan and its [x, y, yaw] covariance; T_w, P
+  /// receive cur's. nndr: ratio test for matching against the keyframe.
+  void track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_prev,
+             const Eigen::Matrix3d& P_prev, double nndr, MotionEstimate& pair,
+             Eigen::Matrix3d& T_w, Eigen::Matrix3d& P);
+
+  /// Variances over [x, y, yaw] of what a constant-velocity step of dt seconds leaves out:
+  /// white-noise acceleration (kStepAccelSigma, kStepAngAccelSigma) over the step. Added to
+  /// the pair step here (the prior) and to the refined estimator's published step.
+  static Eigen::Vector3d stepModelNoise(double dt) {
+    const double ql = 0.5 * kStepAccelSigma * dt * dt, qa = 0.5 * kStepAngAccelSigma * dt * dt;
+    return Eigen::Vector3d(ql * ql, ql * ql, qa * qa);
+  }
+
+  int lastInliers() const { return last_inliers_; }
+  /// The last tracked scan's pose relative to its keyframe (the scan at keyframeStamp(); the
+  /// keyframe in use when the scan was registered, even if the scan then became the next
+  /// one) and its covariance over [x, y, yaw]. What one registration measures: errors of
+  /// successive keyframes are independent, those of scans on one keyframe are not.
+  int64_t keyframeStamp() const { return rel_key_stamp_; }
+  const Eigen::Matrix3d& relativePose() const { return rel_T_; }
+  const Eigen::Matrix3d& relativeCov() const { return rel_C_; }
+  int keyframeSwitches() const { return switches_; }
+
+  static constexpr double kKeyframeDistance = 10.0;  ///< m, new keyframe beyond this
+  static constexpr double kKeyframeAngle = 0.35;     ///< rad
+  static constexpr int kMinInliers = 30;
+  /// m: when descriptor matches cannot register a scan (few and mostly wrong against a
+  /// keyframe turned by 15-30 deg at turn entry or exit), keypoints are paired with the
+  /// nearest keyframe point within this distance of the predicted position instead.
+  static constexpr double kProximityGate = 1.5;
+  static constexpr double kProximityMinAngle = 0.15;  ///< rad, keyframe-to-scan yaw for it
+  static constexpr double kInlierRatio = 0.5;  ///< new keyframe below this x first count
+  static constexpr double kPredictionGate = 2.0;  ///< m, first gate around the prediction
+  // Prior inflation, chosen on the city route (README): velocity prior by acceleration over
+  // kPriorLag scan periods; pose prior (pair step) by white-noise acceleration over a step.
+  static constexpr double kAccelSigma = 3.0;         ///< m/s^2
+  static constexpr double kAngAccelSigma = 1.0;      ///< rad/s^2
+  static constexpr double kPriorLag = 0.1;           ///< scan periods
+  static constexpr double kStepAccelSigma = 0.5;     ///< m/s^2
+  static constexpr double kStepAngAccelSigma = 0.2;  ///< rad/s^2
+  static constexpr int kIterations = 8;
+  /// Each scan's registration is solved for its frame at this fraction of the scan period
+  /// after its first azimuth (mid-scan), not at the scan start (see the top of this file).
+  static constexpr double kMidScan = 0.5;
+  /// Scan periods: the lag the pair velocity really has (its centre is half a scan before
+  /// this scan's), for the published covariance only (kPriorLag steers the estimate).
+  static constexpr double kHonestLag = 0.5;
+
+ private:
+  /// f becomes the keyframe: T_w, P its (published) scan-start pose and covariance, xi its
+  /// velocity, c (s) the time after f.stamp_ns of its reference (mid-scan) frame.
+  void makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d& xi, double c,
+                    const Eigen::Matrix3d& T_w, const Eigen::Matrix3d& P);
+  /// Gauss-Newton; T and xi in/out. False when too few inliers or singular.
+  /// cov: the 6x6 covariance that chains into the next prior (tuned for drift); cov_pub:
+  /// the published one (honest, see the .cpp). Cxi_honest: the velocity prior's covariance
+  /// with its real lag, for cov_pub.
+  bool solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3d& C_prior,
+             const Eigen::Vector3d& xi_prior, const Eigen::Matrix3d& Cxi_prior,
+             const Eigen::Matrix3d& Cxi_honest, Eigen::Matrix3d& T, Eigen::Vector3d& xi,
+             Eigen::Matrix<double, 6, 6>& cov, Eigen::Matrix<double, 6, 6>& cov_pub);
+
+  EstimatorConfig config_;
+  bool has_key_ = false;
+  int64_t last_stamp_ = 0;  ///< previous scan's stamp (for the prior's lag inflation)
+  bool has_last_stamp_ = false;
+  /// Mid-scan reference: the previous scan's offset c (s) and velocity (T_jprev_ is its
+  /// mid-scan frame relative to the keyframe's), the keyframe's c and velocity.
+  double prev_c_ = 0.0, key_c_ = 0.0;
+  Eigen::Vector3d prev_xi_ = Eigen::Vector3d::Zero(), key_xi_ = Eigen::Vector3d::Zero();
+  int switches_ = 0;
+  int last_inliers_ = 0;
+  int key_inliers_ = 0;
+  int64_t key_stamp_ = 0, rel_key_stamp_ = 0;
+  /// The keyframe's velocity covariance (published one): its map's own uncertainty.
+  Eigen::Matrix3d key_xi_cov_ = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d rel_T_ = Eigen::Matrix3d::Identity(), rel_C_ = Eigen::Matrix3d::Zero();  ///< inliers of the first registration to this keyframe (0 = none yet)
+  // Keyframe: points at its reference time in its frame, descriptors, pose.
+  std::vector<Eigen::Vector2d> key_pts_;
+  cv::Mat key_desc_storage_, key_desc_;
+  /// Keyframe: scan-start world pose and its covariance (published).
+  Eigen::Matrix3d T_wj_ = Eigen::Matrix3d::Identity(), P_j_ = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d T_jprev_ = Eigen::Matrix3d::Identity(), C_jprev_ = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d C_jprev_pub_ = Eigen::Matrix3d::Zero();  ///< published covariance of T_jprev_
+  // Per-scan buffers (structure of arrays over the keyframe matches).
+  std::vector<Match> matches_;
+  std::vector<Keypoint> tmp_kps_;
+  std::vector<double> qx_, qy_, px_, py_, ux_, uy_, tau_;
+  std::vector<char> in_;
+  /// Fills the match arrays by proximity to the prediction (see kProximityGate).
+  void associateByProximity(const FeatureFrame& cur, const Eigen::Matrix3d& T_pred,
+                            const Eigen::Vector3d& xi, double c);
+  void addMatch(const Eigen::Vector2d& key_pt, const Keypoint& k, double tau);
+};
+
+}  // namespace spinradar

@@ -1,0 +1,47 @@
+#pragma once
+// Frame-to-frame radar odometry: features of each scan are matched to the previous scan,
+// a motion estimator (rigid, mc, mc_doppler, refined, keyframe) gives the body velocity, and the
+// results are compounded into a pose. The keyframe estimator instead registers each scan to
+// a keyframe with the refined step as prior (keyframe_tracker.hpp) and sets the pose. Pose convention: SE(2) 3x3 matrices, T_ab = pose of
+// frame b expressed in frame a; REP 103 (x forward, y left, yaw CCW).
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "spinradar/core/feature_frame.hpp"
+#include "spinradar/core/params.hpp"
+#include "spinradar/core/polar_scan.hpp"
+#include "spinradar/estimation/motion_estimate.hpp"
+
+namespace spinradar {
+
+class Odometry {
+ public:
+  explicit Odometry(const PipelineConfig& config);  ///< validates config (throws)
+  ~Odometry();
+  Odometry(Odometry&&) noexcept;
+  Odometry& operator=(Odometry&&) noexcept;
+
+  /// Full chain on a polar scan.
+  OdometryResult process(const PolarScan& scan);
+  /// Estimation only, for features computed elsewhere (the feature nodelet).
+  OdometryResult process(const FeatureFrame& frame);
+
+  /// The last frame's keypoints moved to its reference time with the estimated velocity and,
+  /// for mc_doppler/refined, Doppler-corrected: (x, y) in the sensor frame at stamp_ns.
+  const std::vector<Eigen::Vector2d>& correctedPoints() const;
+  /// The same keypoints as measured (no undistortion, no Doppler correction).
+  const std::vector<Eigen::Vector2d>& rawPoints() const;
+
+  void reset();
+  const PipelineConfig& config() const;
+  /// Applies new parameters (e.g. from dynamic_reconfigure) from the next scan on.
+  void setConfig(const PipelineConfig& config);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace spinradar

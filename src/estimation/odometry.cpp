@@ -1,0 +1,271 @@
+// Frame-to-frame odometry: match each scan to the previous one, estimate the motion with the
+// configured estimator, compound the poses.
+#include "spinradar/estimation/odometry.hpp"
+
+#include <chrono>
+#include <stdexcept>
+#include <utility>
+
+#include "spinradar/estimation/doppler.hpp"
+#include "spinradar/features/feature_extractor.hpp"
+#include "spinradar/estimation/keyframe_tracker.hpp"
+#include "spinradar/core/lie.hpp"
+#include "spinradar/features/matcher.hpp"
+#include "spinradar/estimation/mc_ransac.hpp"
+#include "spinradar/estimation/refined_estimator.hpp"
+#include "spinradar/estimation/rigid_ransac.hpp"
+#include "spinradar/estimation/undistort.hpp"
+
+namespace spinradar {
+
+namespace {
+
+enum class Estimator { kRigid, kMc, kMcDoppler, kRefined, kKeyframe };
+
+Estimator parseEstimator(const std::string& name) {
+  if (name == "rigid") return Estimator::kRigid;
+  if (name == "mc") return Estimator::kMc;
+  if (name == "mc_doppler") return Estimator::kMcDoppler;
+  if (name == "refined") return Estimator::kRefined;
+  if (name == "keyframe") return Estimator::kKeyframe;
+  throw std::invalid_argument("parameter 'estimator': unknown value '" + name + "'");
+}
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// A feature frame whose descriptor rows live in a growing storage matrix, so copying a
+/// frame in does not allocate once the storage is large enough.
+struct FrameBuffer {
+  FeatureFrame frame;
+  cv::Mat storage;
+
+  void copyFrom(const FeatureFrame& src) {
+    frame.stamp_ns = src.stamp_ns;
+    frame.keypoints.assign(src.keypoints.begin(), src.keypoints.end());
+    const cv::Mat& d = src.descriptors;
+    if (d.empty()) {
+      frame.descriptors = cv::Mat();
+      return;
+    }
+    if (storage.rows < d.rows || storage.cols != d.cols || storage.type() != d.type())
+      storage.create(std::max(d.rows + d.rows / 2, 64), d.cols, d.type());
+    frame.descriptors = storage.rowRange(0, d.rows);
+    d.copyTo(frame.descriptors);  // same size and type: writes into the view
+  }
+};
+
+}  // namespace
+
+struct Odometry::Impl {
+  PipelineConfig config;
+  Estimator estimator = Estimator::kMcDoppler;
+  bool config_dirty = false;  ///< setConfig() called: apply before the next scan
+  std::unique_ptr<FeatureExtractor> extractor;  ///< created on the first polar scan
+  RigidRansac rigid;
+  McRansac mc;
+  RefinedEstimator refined;
+  KeyframeTracker keyframe;  ///< on top of refined for the keyframe estimator
+
+  FrameBuffer prev, cur;
+  bool has_prev = false;
+  std::vector<Match> matches;
+  std::vector<Keypoint> corr1, corr2;  ///< Doppler-corrected keypoints of prev / cur
+  std::vector<Eigen::Vector2d> corrected, raw;
+
+  Eigen::Matrix3d T_world = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d pose_cov = Eigen::Matrix3d::Zero();
+  MotionEstimate last;  ///< last successful estimate (for a failed scan's prediction)
+  bool has_last = false;
+
+  explicit Impl(const PipelineConfig& c) { apply(c); }
+
+  void apply(const PipelineConfig& c) {
+    c.validate();
+    const bool features_changed = extractor && !sameFeatureConfig(config, c);
+    config = c;
+    const Estimator next = parseEstimator(c.estimator.estimator);
+    if (next != estimator) keyframe.reset();  // its keyframe chain is stale after a switch
+    estimator = next;
+    rigid.setConfig(c.estimator);
+    mc.setConfig(c.estimator);
+    refined.setConfig(c.estimator);
+    keyframe.setConfig(c.estimator);
+    if (features_changed) extractor.reset();  // rebuilt with the new settings on demand
+  }
+
+  static bool sameFeatureConfig(const PipelineConfig& a, const PipelineConfig& b) {
+    bool same = true;
+    auto cmp = [&](const auto& x, const auto& y) {
+      std::vector<std::string> va, vb;
+      x.visit([&](const ParamMeta&, const auto& v) { va.push_back(toString(v)); });
+      y.visit([&](const ParamMeta&, const auto& v) { vb.push_back(toString(v)); });
+      same = same && va == vb;
+    };
+    cmp(a.detector, b.detector);
+    cmp(a.features, b.features);
+    return same;
+  }
+  template <class T>
+  static std::string toString(const T& v) {
+    if constexpr (std::is_same_v<T, std::string>) return v;
+    else return std::to_string(v);
+  }
+
+  void reset() {
+    has_prev = false;
+    has_last = false;
+    T_world.setIdentity();
+    pose_cov.setZero();
+    refined.reset();
+    keyframe.reset();
+    corrected.clear();
+    raw.clear();
+  }
+
+  bool estimate(MotionEstimate& m) {
+    const FeatureFrame& a = prev.frame;
+    const FeatureFrame& b = cur.frame;
+    switch (estimator) {
+      case Estimator::kRigid:
+        return rigid.estimate(a.keypoints, b.keypoints, matches, a.stamp_ns, b.stamp_ns, m);
+      case Estimator::kMc:
+        return mc.estimate(a.keypoints, b.keypoints, matches, a.stamp_ns, b.stamp_ns, m);
+      case Estimator::kMcDoppler:
+        return estimateMcDoppler(mc, a.keypoints, b.keypoints, matches, a.stamp_ns, b.stamp_ns,
+                                 config.estimator.beta, corr1, corr2, m);
+      case Estimator::kRefined:
+      case Estimator::kKeyframe:
+        return refined.estimate(a, b, matches, corr1, corr2, m);
+    }
+    return false;
+  }
+
+  /// Estimation and compounding on cur (prev is the previous scan, when there is one).
+  OdometryResult step(StageTimes times) {
+    OdometryResult res;
+    res.stamp_ns = cur.frame.stamp_ns;
+    const std::vector<Keypoint>& kps = cur.frame.keypoints;
+    raw.resize(kps.size());
+    for (size_t i = 0; i < kps.size(); ++i) raw[i] = {kps[i].x, kps[i].y};
+
+    bool have_velocity = false;
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+    bool doppler = false;
+    if (has_prev) {
+      auto t0 = std::chrono::steady_clock::now();
+      matchDescriptors(prev.frame.descriptors, cur.frame.descriptors,
+                       config.features.nndr, matches);
+      times.match_ms = msSince(t0);
+      t0 = std::chrono::steady_clock::now();
+      MotionEstimate& m = res.motion;
+      const bool ok = estimate(m);
+      if (ok && estimator == Estimator::kKeyframe) {
+        Eigen::Matrix3d T_new, P_new;
+        keyframe.track(cur.frame, T_world, pose_cov, config.features.nndr, m, T_new, P_new);
+        setPose(T_new, P_new);
+        res.keyframe_stamp_ns = keyframe.keyframeStamp();
+        res.T_keyframe_sensor = keyframe.relativePose();
+        res.keyframe_cov = keyframe.relativeCov();
+        dopplerCorrect(cur.frame.keypoints, m.velocity, config.estimator.beta, corr2);
+      } else if (!ok) {
+        keyframe.reset();  // the prediction below is not tied to the keyframe
+      }
+      times.estimate_ms = msSince(t0);
+      const double dt_ref = 1e-9 * static_cast<double>(cur.frame.stamp_ns - prev.frame.stamp_ns);
+      if (ok) {
+        if (estimator == Estimator::kRefined || estimator == Estimator::kKeyframe) {
+          // Published covariance (NEES on the city route): the refined step and velocity
+          // assume a constant velocity over the pair; add what acceleration over the step
+          // leaves out, the same model the keyframe estimator puts on this step as its prior.
+          // Covariance only: the pose and the estimate are unchanged. (For keyframe: the
+          // refined pair's step and velocity, the latter published, see keyframe_tracker.cpp.)
+          const Eigen::Vector3d q = KeyframeTracker::stepModelNoise(dt_ref);
+          m.T_12_cov.diagonal() += q;
+          const double h = 0.5 * dt_ref;  // the velocity stands for the step's centre
+          m.velocity_cov.diagonal() +=
+              Eigen::Vector3d(KeyframeTracker::kStepAccelSigma * h, KeyframeTracker::kStepAccelSigma * h,
+                              KeyframeTracker::kStepAngAccelSigma * h).cwiseAbs2();
+        }
+        if (estimator != Estimator::kKeyframe) compound(m.T_12, m.T_12_cov);
+        last = m;
+        has_last = true;
+        res.ok = true;
+        doppler = estimator == Estimator::kMcDoppler || estimator == Estimator::kRefined ||
+                  estimator == Estimator::kKeyframe;
+      } else if (has_last && dt_ref > 0.0) {
+        // Estimation failed (too few matches, degenerate geometry): predict with the last
+        // velocity so the trajectory stays continuous; res.ok = false reports the failure.
+        const int n_matches = m.matches;
+        m = last;
+        m.ok = false;
+        m.matches = n_matches;
+        m.inliers.clear();
+        setMotionFromVelocity(last.velocity, last.velocity_cov, dt_ref, m);
+        compound(m.T_12, m.T_12_cov);
+      }
+      velocity = m.velocity;
+      have_velocity = ok || (has_last && dt_ref > 0.0);
+    }
+    // Corrected points: Doppler-corrected keypoints (if this estimator corrects) moved to
+    // the scan's reference time with the estimated velocity.
+    const std::vector<Keypoint>& src = doppler ? corr2 : kps;
+    if (have_velocity) {
+      undistortPoints(src, velocity, cur.frame.stamp_ns, corrected);
+    } else {
+      corrected.assign(raw.begin(), raw.end());
+    }
+    res.T_world_sensor = T_world;
+    res.pose_cov = pose_cov;
+    res.times = times;
+    std::swap(prev, cur);
+    has_prev = true;
+    return res;
+  }
+
+  /// T_world <- T_world T_12 with first-order propagation over [x, y, yaw] (se2::compoundXyYaw):
+  /// p' = p + R(yaw) t, yaw' = yaw + dyaw.
+  void compound(const Eigen::Matrix3d& T_12, const Eigen::Matrix3d& cov_12) {
+    Eigen::Matrix3d T, P;
+    se2::compoundXyYaw(T_world, pose_cov, T_12, cov_12, T, P);
+    setPose(T, P);
+  }
+
+  void setPose(const Eigen::Matrix3d& T, const Eigen::Matrix3d& P) {
+    T_world = T;
+    pose_cov = P;
+    // Re-orthonormalise the rotation against round-off over long runs.
+    const double yaw = std::atan2(T_world(1, 0), T_world(0, 0));
+    T_world.topLeftCorner<2, 2>() << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
+  }
+};
+
+Odometry::Odometry(const PipelineConfig& config) : impl_(std::make_unique<Impl>(config)) {}
+Odometry::~Odometry() = default;
+Odometry::Odometry(Odometry&&) noexcept = default;
+Odometry& Odometry::operator=(Odometry&&) noexcept = default;
+
+OdometryResult Odometry::process(const PolarScan& scan) {
+  Impl& d = *impl_;
+  if (!d.extractor)
+    d.extractor = std::make_unique<FeatureExtractor>(d.config.detector, d.config.features);
+  StageTimes times;
+  d.extractor->extract(scan, d.cur.frame, &times);
+  return d.step(times);
+}
+
+OdometryResult Odometry::process(const FeatureFrame& frame) {
+  Impl& d = *impl_;
+  d.cur.copyFrom(frame);
+  return d.step(StageTimes{});
+}
+
+const std::vector<Eigen::Vector2d>& Odometry::correctedPoints() const { return impl_->corrected; }
+const std::vector<Eigen::Vector2d>& Odometry::rawPoints() const { return impl_->raw; }
+
+void Odometry::reset() { impl_->reset(); }
+const PipelineConfig& Odometry::config() const { return impl_->config; }
+void Odometry::setConfig(const PipelineConfig& config) { impl_->apply(config); }
+
+}  // namespace spinradar

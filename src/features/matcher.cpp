@@ -1,0 +1,263 @@
+// Brute-force Hamming matching with the ratio test.
+// Portable kernel: for 32-byte (ORB) descriptors the distance is four 64-bit XOR + POPCNT, four
+// query rows against each train row at once (popcount-throughput bound, ~4 cycles a pair).
+// SIMD kernels, chosen at run time: the train descriptors are transposed into blocks of rows
+// per 64-bit word, so one instruction gives the partial distances of several train rows.
+// AVX-512 VPOPCNTDQ (8 rows a register) and AVX2 (4 rows, nibble-table popcount). Measured on
+// the real Oxford pair (1718 x 1680 descriptors, one core): scalar 4.3 ms, AVX2 3.4 ms,
+// AVX-512 1.9 ms; cv::BFMatcher::knnMatch 30 ms.
+// Buffers are thread-local and reused: no allocation per call once warmed up, besides `out`.
+#include "spinradar/features/matcher.hpp"
+
+#include "matcher_kernels.hpp"
+
+#include <climits>
+#include <cstdint>
+#include <cstring>
+#include <immintrin.h>
+#include <stdexcept>
+
+namespace spinradar {
+
+namespace {
+
+inline int popcount64(uint64_t v) { return __builtin_popcountll(v); }
+
+struct Best2 {
+  int d1 = INT_MAX, d2 = INT_MAX, j = -1;
+  inline void push(int d, int idx) {
+    if (d < d2) {
+      if (d < d1) {
+        d2 = d1;
+        d1 = d;
+        j = idx;
+      } else {
+        d2 = d;
+      }
+    }
+  }
+};
+
+inline uint64_t load64(const uint8_t* p) {
+  uint64_t v;
+  std::memcpy(&v, p, 8);
+  return v;
+}
+
+void emit(const Best2& b, int i, double nndr, std::vector<Match>& out) {
+  // second == INT_MAX when d2 has a single row: no ratio test possible, no match.
+  if (b.j >= 0 && b.d2 != INT_MAX && double(b.d1) < nndr * double(b.d2))
+    out.push_back({i, b.j, static_cast<float>(b.d1)});
+}
+
+void match32(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Match>& out) {
+  const int n1 = d1.rows, n2 = d2.rows;
+  int i = 0;
+  for (; i + 4 <= n1; i += 4) {
+    uint64_t q[4][4];
+    for (int r = 0; r < 4; ++r)
+      for (int w = 0; w < 4; ++w) q[r][w] = load64(d1.ptr<uint8_t>(i + r) + 8 * w);
+    Best2 b[4];
+    for (int j = 0; j < n2; ++j) {
+      const uint8_t* t = d2.ptr<uint8_t>(j);
+      const uint64_t t0 = load64(t), t1 = load64(t + 8), t2 = load64(t + 16), t3 = load64(t + 24);
+      for (int r = 0; r < 4; ++r) {
+        const int d = popcount64(q[r][0] ^ t0) + popcount64(q[r][1] ^ t1) + popcount64(q[r][2] ^ t2) +
+                      popcount64(q[r][3] ^ t3);
+        b[r].push(d, j);
+      }
+    }
+    for (int r = 0; r < 4; ++r) emit(b[r], i + r, nndr, out);
+  }
+  for (; i < n1; ++i) {
+    const uint8_t* s = d1.ptr<uint8_t>(i);
+    const uint64_t q0 = load64(s), q1 = load64(s + 8), q2 = load64(s + 16), q3 = load64(s + 24);
+    Best2 b;
+    for (int j = 0; j < n2; ++j) {
+      const uint8_t* t = d2.ptr<uint8_t>(j);
+      b.push(popcount64(q0 ^ load64(t)) + popcount64(q1 ^ load64(t + 8)) + popcount64(q2 ^ load64(t + 16)) +
+                 popcount64(q3 ^ load64(t + 24)),
+             j);
+    }
+    emit(b, i, nndr, out);
+  }
+}
+
+void matchGeneric(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Match>& out) {
+  const int bytes = d1.cols;
+  for (int i = 0; i < d1.rows; ++i) {
+    const uint8_t* s = d1.ptr<uint8_t>(i);
+    Best2 b;
+    for (int j = 0; j < d2.rows; ++j) {
+      const uint8_t* t = d2.ptr<uint8_t>(j);
+      int d = 0, k = 0;
+      for (; k + 8 <= bytes; k += 8) d += popcount64(load64(s + k) ^ load64(t + k));
+      for (; k < bytes; ++k) d += __builtin_popcount(unsigned(s[k] ^ t[k]));
+      b.push(d, j);
+    }
+    emit(b, i, nndr, out);
+  }
+}
+
+}  // namespace
+
+namespace detail {
+
+void matchScalar(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Match>& out) {
+  if (d1.cols == 32)
+    match32(d1, d2, nndr, out);
+  else
+    matchGeneric(d1, d2, nndr, out);
+}
+
+namespace {
+bool cpuHasAvx512Popcnt() {
+#if defined(__GNUC__) && defined(__x86_64__)
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vpopcntdq");
+#else
+  return false;
+#endif
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+__attribute__((target("avx512f,avx512vpopcntdq"))) void match32Avx512(const cv::Mat& d1, const cv::Mat& d2,
+                                                                       double nndr, std::vector<Match>& out,
+                                                                       std::vector<uint64_t>& soa) {
+  const int n2 = d2.rows, blocks = (n2 + 7) / 8;
+  soa.resize(size_t(blocks) * 32);
+  // soa[(b * 4 + w) * 8 + lane] = word w of train row 8 b + lane; padding lanes never win (masked).
+  for (int b = 0; b < blocks; ++b)
+    for (int lane = 0; lane < 8; ++lane) {
+      const int j = b * 8 + lane;
+      for (int w = 0; w < 4; ++w) soa[(size_t(b) * 4 + w) * 8 + lane] = j < n2 ? load64(d2.ptr<uint8_t>(j) + 8 * w) : 0;
+    }
+  const __mmask8 last_valid = static_cast<__mmask8>((1u << (n2 - (blocks - 1) * 8)) - 1u);
+  for (int i = 0; i < d1.rows; ++i) {
+    const uint8_t* s = d1.ptr<uint8_t>(i);
+    const __m512i q0 = _mm512_set1_epi64(static_cast<long long>(load64(s)));
+    const __m512i q1 = _mm512_set1_epi64(static_cast<long long>(load64(s + 8)));
+    const __m512i q2 = _mm512_set1_epi64(static_cast<long long>(load64(s + 16)));
+    const __m512i q3 = _mm512_set1_epi64(static_cast<long long>(load64(s + 24)));
+    Best2 best;
+    __m512i thr = _mm512_set1_epi64(INT_MAX);
+    const uint64_t* t = soa.data();
+    for (int b = 0; b < blocks; ++b, t += 32) {
+      __m512i d = _mm512_popcnt_epi64(_mm512_xor_si512(q0, _mm512_loadu_si512(t)));
+      d = _mm512_add_epi64(d, _mm512_popcnt_epi64(_mm512_xor_si512(q1, _mm512_loadu_si512(t + 8))));
+      d = _mm512_add_epi64(d, _mm512_popcnt_epi64(_mm512_xor_si512(q2, _mm512_loadu_si512(t + 16))));
+      d = _mm512_add_epi64(d, _mm512_popcnt_epi64(_mm512_xor_si512(q3, _mm512_loadu_si512(t + 24))));
+      unsigned m = _mm512_cmplt_epu64_mask(d, thr);  // only lanes that can change the best two
+      if (b == blocks - 1) m &= last_valid;           // padding lanes are not rows
+      if (!m) continue;
+      alignas(64) uint64_t dv[8];
+      _mm512_store_si512(dv, d);
+      while (m) {
+        const int lane = __builtin_ctz(m);
+        m &= m - 1;
+        best.push(static_cast<int>(dv[lane]), b * 8 + lane);
+      }
+      thr = _mm512_set1_epi64(best.d2);
+    }
+    emit(best, i, nndr, out);
+  }
+}
+
+bool cpuHasAvx2() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2");
+}
+
+/// Per-byte popcount of x (nibble table lookup).
+__attribute__((target("avx2"))) inline __m256i byteCount(__m256i x, __m256i lut, __m256i nib) {
+  const __m256i lo = _mm256_and_si256(x, nib), hi = _mm256_and_si256(_mm256_srli_epi16(x, 4), nib);
+  return _mm256_add_epi8(_mm256_shuffle_epi8(lut, lo), _mm256_shuffle_epi8(lut, hi));
+}
+
+__attribute__((target("avx2,popcnt"))) void match32Avx2(const cv::Mat& d1, const cv::Mat& d2, double nndr,
+                                                         std::vector<Match>& out, std::vector<uint64_t>& soa) {
+  const int n2 = d2.rows, blocks = (n2 + 3) / 4;
+  soa.resize(size_t(blocks) * 16);
+  // soa[(b * 4 + w) * 4 + lane] = word w of train row 4 b + lane
+  for (int b = 0; b < blocks; ++b)
+    for (int lane = 0; lane < 4; ++lane) {
+      const int j = b * 4 + lane;
+      for (int w = 0; w < 4; ++w) soa[(size_t(b) * 4 + w) * 4 + lane] = j < n2 ? load64(d2.ptr<uint8_t>(j) + 8 * w) : 0;
+    }
+  const __m256i lut = _mm256_setr_epi8(0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4, 0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2,
+                                       3, 2, 3, 3, 4);
+  const __m256i nib = _mm256_set1_epi8(0x0f), zero = _mm256_setzero_si256();
+  const int last_valid = (1 << (n2 - (blocks - 1) * 4)) - 1;
+  for (int i = 0; i < d1.rows; ++i) {
+    const uint8_t* s = d1.ptr<uint8_t>(i);
+    const __m256i q0 = _mm256_set1_epi64x(static_cast<long long>(load64(s)));
+    const __m256i q1 = _mm256_set1_epi64x(static_cast<long long>(load64(s + 8)));
+    const __m256i q2 = _mm256_set1_epi64x(static_cast<long long>(load64(s + 16)));
+    const __m256i q3 = _mm256_set1_epi64x(static_cast<long long>(load64(s + 24)));
+    Best2 best;
+    __m256i thr = _mm256_set1_epi64x(INT_MAX);
+    const uint64_t* t = soa.data();
+    for (int b = 0; b < blocks; ++b, t += 16) {
+      const __m256i t0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(t));
+      const __m256i t1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(t + 4));
+      const __m256i t2 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(t + 8));
+      const __m256i t3 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(t + 12));
+      __m256i c = _mm256_add_epi8(byteCount(_mm256_xor_si256(q0, t0), lut, nib),
+                                  byteCount(_mm256_xor_si256(q1, t1), lut, nib));
+      c = _mm256_add_epi8(c, _mm256_add_epi8(byteCount(_mm256_xor_si256(q2, t2), lut, nib),
+                                             byteCount(_mm256_xor_si256(q3, t3), lut, nib)));
+      const __m256i d = _mm256_sad_epu8(c, zero);  // four distances, one per 64-bit lane
+      int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpgt_epi64(thr, d)));
+      if (b == blocks - 1) m &= last_valid;
+      if (!m) continue;
+      alignas(32) uint64_t dv[4];
+      _mm256_store_si256(reinterpret_cast<__m256i*>(dv), d);
+      while (m) {
+        const int lane = __builtin_ctz(static_cast<unsigned>(m));
+        m &= m - 1;
+        best.push(static_cast<int>(dv[lane]), b * 4 + lane);
+      }
+      thr = _mm256_set1_epi64x(best.d2);
+    }
+    emit(best, i, nndr, out);
+  }
+}
+#endif
+}  // namespace
+
+bool matchAvx2(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Match>& out) {
+#if defined(__GNUC__) && defined(__x86_64__)
+  static const bool supported = cpuHasAvx2();
+  if (!supported || d1.cols != 32) return false;
+  thread_local std::vector<uint64_t> soa;
+  match32Avx2(d1, d2, nndr, out, soa);
+  return true;
+#else
+  return false;
+#endif
+}
+
+bool matchAvx512(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Match>& out) {
+#if defined(__GNUC__) && defined(__x86_64__)
+  static const bool supported = cpuHasAvx512Popcnt();
+  if (!supported || d1.cols != 32) return false;
+  thread_local std::vector<uint64_t> soa;
+  match32Avx512(d1, d2, nndr, out, soa);
+  return true;
+#else
+  return false;
+#endif
+}
+
+}  // namespace detail
+
+void matchDescriptors(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Match>& out) {
+  out.clear();
+  if (d1.empty() || d2.empty()) return;
+  if (d1.type() != CV_8UC1 || d2.type() != CV_8UC1 || d1.cols != d2.cols)
+    throw std::invalid_argument("matchDescriptors: both descriptor sets must be CV_8UC1 with equal widths");
+  if (!detail::matchAvx512(d1, d2, nndr, out) && !detail::matchAvx2(d1, d2, nndr, out))
+    detail::matchScalar(d1, d2, nndr, out);
+}
+
+}  // namespace spinradar

@@ -1,0 +1,234 @@
+// Oxford Radar RobotCar and Boreas polar PNGs (the "Navtech rows" layout).
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "spinradar/io/scan_io.hpp"
+#include "scan_io_detail.hpp"
+
+namespace spinradar {
+
+namespace {
+
+std::mutex g_warn_mutex;
+ScanWarningHandler g_warn_handler;
+
+enum class Column10 { Valid, BoreasAuto };
+
+int64_t readI64(const uint8_t* p) {
+  uint64_t v = 0;
+  for (int i = 7; i >= 0; --i) v = (v << 8) | p[i];
+  return static_cast<int64_t>(v);
+}
+uint16_t readU16(const uint8_t* p) { return static_cast<uint16_t>(p[0] | (p[1] << 8)); }
+void writeI64(uint8_t* p, int64_t s) {
+  uint64_t v = static_cast<uint64_t>(s);
+  for (int i = 0; i < 8; ++i, v >>= 8) p[i] = static_cast<uint8_t>(v & 0xff);
+}
+
+/// Boreas-RT marks chirps by alternating column 10; accept it when nearly every row flips.
+bool looksLikeChirpColumn(const cv::Mat& img) {
+  if (img.rows < 4) return false;
+  int flips = 0, mixed = 0;
+  for (int a = 0; a < img.rows; ++a) {
+    const uint8_t v = img.ptr<uint8_t>(a)[10];
+    if (v != 0 && v != 255) ++mixed;
+    if (a > 0 && v != img.ptr<uint8_t>(a - 1)[10]) ++flips;
+  }
+  return mixed == 0 && flips >= (img.rows - 1) * 9 / 10;
+}
+
+PolarScan decodeRows(const cv::Mat& img, const std::string& name, double resolution,
+                     double offset, Column10 col10) {
+  if (img.empty()) throw std::runtime_error(name + ": empty image");
+  if (img.depth() != CV_8U || img.channels() != 1) {
+    std::ostringstream s;
+    s << name << ": " << img.channels() << " channel(s) of " << (img.elemSize1() * 8)
+      << "-bit, an 8-bit single-channel image expected";
+    throw std::runtime_error(s.str());
+  }
+  if (img.cols <= kNavtechMetaColumns) {
+    std::ostringstream s;
+    s << name << ": " << img.cols << " columns but " << kNavtechMetaColumns
+      << " metadata columns + at least 1 bin expected";
+    throw std::runtime_error(s.str());
+  }
+  PolarScan scan;
+  scan.resize(img.rows, img.cols - kNavtechMetaColumns);
+  scan.range_resolution = resolution;
+  scan.range_offset = offset;
+  scan.encoder_size = 5600;
+  const bool chirp = col10 == Column10::BoreasAuto && looksLikeChirpColumn(img);
+  if (chirp) scan.chirp_up.assign(img.rows, 0);
+  const double two_pi = 2.0 * M_PI;
+  for (int a = 0; a < img.rows; ++a) {
+    const uint8_t* p = img.ptr<uint8_t>(a);
+    const int64_t us = readI64(p);
+    const uint16_t enc = readU16(p + 8);
+    if (enc >= scan.encoder_size) {
+      std::ostringstream s;
+      s << name << ": row " << a << ": encoder " << enc << " >= " << scan.encoder_size;
+      throw std::runtime_error(s.str());
+    }
+    scan.stamp_ns[a] = us * 1000;
+    scan.encoder[a] = enc;
+    scan.azimuth[a] = two_pi * enc / scan.encoder_size;
+    if (chirp) {
+      scan.chirp_up[a] = p[10] == 255 ? 1 : 0;
+      scan.valid[a] = 1;
+    } else if (col10 == Column10::Valid) {
+      scan.valid[a] = p[10] == 255 ? 1 : 0;  // as the Oxford SDK tests it
+    } else {
+      scan.valid[a] = 1;  // Boreas without chirps: column 10 carries no flag we rely on
+    }
+    std::memcpy(scan.row(a), p + kNavtechMetaColumns, scan.bins);
+  }
+  detail::markMissingAndDuplicates(scan, name);
+  return scan;
+}
+
+cv::Mat readGray(const std::string& path) {
+  {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) throw std::runtime_error(path + ": cannot open file");
+    char sig[8] = {};
+    f.read(sig, 8);
+    static const char png_sig[8] = {'\x89', 'P', 'N', 'G', '\r', '\n', '\x1a', '\n'};
+    if (f.gcount() < 8 || std::memcmp(sig, png_sig, 8) != 0)
+      throw std::runtime_error(path + ": not a PNG file (bad signature)");
+  }
+  cv::Mat img;
+  try {
+    img = cv::imread(path, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error(path + ": unreadable PNG (" + e.what() + ")");
+  }
+  if (img.empty()) throw std::runtime_error(path + ": unreadable PNG (corrupt or truncated)");
+  return img;
+}
+
+void writePng(const cv::Mat& img, const std::string& path) {
+  const auto dot = path.rfind('.');
+  std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  if (ext != ".png")
+    throw std::runtime_error(path + ": the polar layout needs a lossless .png file name");
+  bool ok = false;
+  try {
+    ok = cv::imwrite(path, img, {cv::IMWRITE_PNG_COMPRESSION, 1});
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error(path + ": cannot write PNG (" + e.what() + ")");
+  }
+  if (!ok) throw std::runtime_error(path + ": cannot write PNG");
+}
+
+void encodeRows(const PolarScan& scan, cv::Mat& img, bool chirp_column) {
+  if (scan.empty()) throw std::runtime_error("cannot encode an empty scan");
+  if (scan.power.size() != static_cast<size_t>(scan.azimuths) * scan.bins)
+    throw std::runtime_error("cannot encode scan: power has " + std::to_string(scan.power.size()) +
+                             " values, azimuths x bins expected");
+  img.create(scan.azimuths, scan.bins + kNavtechMetaColumns, CV_8UC1);
+  // The layout has no field for the encoder size: it is always 5600. Other sensors' encoders are
+  // rewritten from the angles so that the file still reads back with the right angles.
+  const bool have_enc = scan.encoder.size() == static_cast<size_t>(scan.azimuths) && scan.encoder_size == 5600;
+  for (int a = 0; a < scan.azimuths; ++a) {
+    uint8_t* p = img.ptr<uint8_t>(a);
+    const int64_t ns = a < static_cast<int>(scan.stamp_ns.size()) ? scan.stamp_ns[a] : 0;
+    writeI64(p, ns / 1000);
+    int enc = 0;
+    if (have_enc) {
+      enc = scan.encoder[a];
+    } else if (a < static_cast<int>(scan.azimuth.size())) {
+      const double turns = scan.azimuth[a] / (2.0 * M_PI);
+      enc = static_cast<int>(std::lround((turns - std::floor(turns)) * 5600.0)) % 5600;
+    }
+    p[8] = static_cast<uint8_t>(enc & 0xff);
+    p[9] = static_cast<uint8_t>((enc >> 8) & 0xff);
+    const bool valid = a >= static_cast<int>(scan.valid.size()) || scan.valid[a] != 0;
+    if (chirp_column && scan.chirp_up.size() == static_cast<size_t>(scan.azimuths))
+      p[10] = scan.chirp_up[a] ? 255 : 0;
+    else
+      p[10] = valid ? 255 : 0;
+    std::memcpy(p + kNavtechMetaColumns, scan.row(a), scan.bins);
+  }
+}
+
+}  // namespace
+
+void setScanWarningHandler(ScanWarningHandler handler) {
+  std::lock_guard<std::mutex> lock(g_warn_mutex);
+  g_warn_handler = std::move(handler);
+}
+
+void scanWarning(const std::string& message) {
+  std::lock_guard<std::mutex> lock(g_warn_mutex);
+  if (g_warn_handler)
+    g_warn_handler(message);
+  else
+    std::cerr << "spinradar warning: " << message << "\n";
+}
+
+PolarScan decodeOxfordImage(const cv::Mat& image, const std::string& name,
+                            double range_resolution, double range_offset) {
+  return decodeRows(image, name, range_resolution, range_offset, Column10::Valid);
+}
+
+void encodeOxfordImage(const PolarScan& scan, cv::Mat& image) { encodeRows(scan, image, false); }
+
+PolarScan loadOxfordPng(const std::string& path, double range_resolution, double range_offset) {
+  return decodeRows(readGray(path), path, range_resolution, range_offset, Column10::Valid);
+}
+
+void saveOxfordPng(const PolarScan& scan, const std::string& path) {
+  cv::Mat img;
+  try {
+    encodeRows(scan, img, false);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  writePng(img, path);
+}
+
+PolarScan loadBoreasPng(const std::string& path, double range_offset) {
+  const cv::Mat img = readGray(path);
+  const int bins = img.cols - kNavtechMetaColumns;
+  double res = 0.0;
+  if (bins == 3360)
+    res = 0.0596;
+  else if (bins == 6848)
+    res = 0.04381;
+  else {
+    std::ostringstream s;
+    s << path << ": " << img.cols << " columns but " << kNavtechMetaColumns << " + 3360 or "
+      << kNavtechMetaColumns << " + 6848 bins expected (Boreas layout)";
+    throw std::runtime_error(s.str());
+  }
+  PolarScan scan = decodeRows(img, path, res, range_offset, Column10::BoreasAuto);
+  if (bins == 3360 && !scan.stamp_ns.empty() && scan.stamp_ns.front() / 1000 > kBoreasUpgradeUs)
+    scan.range_resolution = 0.04381;  // same width, finer bins after the upgrade (pyboreas)
+  return scan;
+}
+
+void saveBoreasPng(const PolarScan& scan, const std::string& path) {
+  cv::Mat img;
+  try {
+    encodeRows(scan, img, true);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  writePng(img, path);
+}
+
+int64_t boreasFileStampUs(const PolarScan& scan) {
+  if (scan.stamp_ns.empty()) return 0;
+  return scan.stamp_ns[scan.stamp_ns.size() / 2] / 1000;
+}
+
+}  // namespace spinradar

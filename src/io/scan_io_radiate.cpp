@@ -1,0 +1,48 @@
+// RADIATE polar PNG: transposed (width = azimuths, height = bins), no per-row metadata.
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "spinradar/io/scan_io.hpp"
+
+namespace spinradar {
+
+PolarScan loadRadiatePng(const std::string& path, int64_t scan_stamp_ns, double rotation_hz,
+                         double range_resolution, double range_offset) {
+  cv::Mat img;
+  try {
+    img = cv::imread(path, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error(path + ": unreadable PNG (" + e.what() + ")");
+  }
+  if (img.empty()) throw std::runtime_error(path + ": cannot read image (missing, corrupt or not a PNG)");
+  if (img.depth() != CV_8U || img.channels() != 1) {
+    std::ostringstream s;
+    s << path << ": " << img.channels() << " channel(s) of " << img.elemSize1() * 8
+      << "-bit, an 8-bit single-channel image expected";
+    throw std::runtime_error(s.str());
+  }
+  if (rotation_hz <= 0) throw std::runtime_error(path + ": rotation_hz must be positive");
+  PolarScan scan;
+  scan.resize(img.cols, img.rows);
+  scan.range_resolution = range_resolution;
+  scan.range_offset = range_offset;
+  scan.encoder_size = 5600;
+  cv::Mat rows(scan.azimuths, scan.bins, CV_8UC1, scan.power.data());
+  cv::transpose(img, rows);
+  // RADIATE stores one time per scan: the per-azimuth stamps below are synthesised, evenly
+  // spread over one rotation starting at the scan time.
+  const double period_ns = 1e9 / rotation_hz;
+  for (int a = 0; a < scan.azimuths; ++a) {
+    scan.azimuth[a] = 2.0 * M_PI * a / scan.azimuths;
+    scan.encoder[a] = static_cast<uint16_t>(std::lround(double(a) * scan.encoder_size / scan.azimuths) %
+                                            scan.encoder_size);
+    scan.stamp_ns[a] = scan_stamp_ns + static_cast<int64_t>(std::llround(period_ns * a / scan.azimuths));
+  }
+  return scan;
+}
+
+}  // namespace spinradar
