@@ -14,9 +14,13 @@ function(spinradar_part part)
   target_compile_options(spinradar_${part} PRIVATE -O3 -march=x86-64-v2)
 endfunction()
 
+# Fast PNG decoding of recorded scans (src/io/png_gray8.cpp).
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(SPINRADAR_PNG REQUIRED IMPORTED_TARGET libdeflate spng)
+
 spinradar_part(core                       LIBS Eigen3::Eigen opencv_core)
 spinradar_part(driver       USES core     LIBS Threads::Threads)
-spinradar_part(io           USES core     LIBS opencv_imgcodecs)
+spinradar_part(io           USES core     LIBS opencv_imgcodecs PkgConfig::SPINRADAR_PNG)
 spinradar_part(features     USES core     LIBS opencv_features2d opencv_imgproc)
 spinradar_part(estimation   USES features core)
 spinradar_part(evaluation   USES io core  LIBS opencv_imgproc opencv_imgcodecs)

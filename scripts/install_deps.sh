@@ -4,6 +4,7 @@ set -euo pipefail
 PKGS=(
   build-essential cmake git pkg-config
   libeigen3-dev libopencv-dev nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libtbb-dev
+  libdeflate-dev libspng-dev
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   catkin ros-core-dev ros-message-generation libnodeletlib-dev libnodeletlib-tools
   libtf2-ros-dev libtf2-eigen-dev librosbag-dev python3-rosbag python3-rostest python3-roslaunch

@@ -45,6 +45,10 @@ if(EXISTS ${PROJECT_SOURCE_DIR}/src/tools/cmd_odometry.cpp)
   add_test(NAME cli_odometry_oxford_sample
     COMMAND bash ${_tt}/oxford_odometry.sh ${_cli} ${SPINRADAR_SHARED_DIR} ${_out}/oxford)
   set_tests_properties(cli_odometry_oxford_sample PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 300)
+  # Background decoding (--threads 2) writes byte-identical outputs, in scan order.
+  add_test(NAME cli_odometry_threads_identical
+    COMMAND bash ${_tt}/odometry_threads_identical.sh ${_cli} ${_out}/threads)
+  set_tests_properties(cli_odometry_threads_identical PROPERTIES TIMEOUT 300)
   # The grouped YAML form is accepted and overrides the defaults (estimator rigid -> log line).
   add_test(NAME cli_odometry_grouped_config
     COMMAND bash ${_tt}/with_realdata.sh ${SPINRADAR_SHARED_DIR} ${_cli} odometry --input ${SPINRADAR_SHARED_DIR}/realdata/oxford_2019-01-10-14-36-48

@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <iostream>
 #include <mutex>
 #include <sstream>
@@ -10,6 +9,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "spinradar/io/png_gray8.hpp"
 #include "spinradar/io/scan_io.hpp"
 #include "scan_io_detail.hpp"
 
@@ -94,19 +94,18 @@ PolarScan decodeRows(const cv::Mat& img, const std::string& name, double resolut
   return scan;
 }
 
+/// The returned image may point into this thread's decoder buffer: use it before the next call.
 cv::Mat readGray(const std::string& path) {
-  {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) throw std::runtime_error(path + ": cannot open file");
-    char sig[8] = {};
-    f.read(sig, 8);
-    static const char png_sig[8] = {'\x89', 'P', 'N', 'G', '\r', '\n', '\x1a', '\n'};
-    if (f.gcount() < 8 || std::memcmp(sig, png_sig, 8) != 0)
-      throw std::runtime_error(path + ": not a PNG file (bad signature)");
-  }
+  thread_local std::vector<uint8_t> bytes;
+  thread_local PngGray8Decoder fast;  // exact OpenCV output, several times faster; else OpenCV
+  readFileBytes(path, bytes);
+  static const uint8_t png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (bytes.size() < 8 || std::memcmp(bytes.data(), png_sig, 8) != 0)
+    throw std::runtime_error(path + ": not a PNG file (bad signature)");
   cv::Mat img;
+  if (fast.decode(bytes.data(), bytes.size(), img)) return img;
   try {
-    img = cv::imread(path, cv::IMREAD_UNCHANGED);
+    img = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data()), cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
     throw std::runtime_error(path + ": unreadable PNG (" + e.what() + ")");
   }

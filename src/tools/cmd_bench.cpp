@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <tbb/global_control.h>
 
 #include "command.hpp"
@@ -20,7 +22,9 @@
 #include "spinradar/features/feature_extractor.hpp"
 #include "spinradar/features/matcher.hpp"
 #include "spinradar/estimation/odometry.hpp"
+#include "spinradar/io/png_gray8.hpp"
 #include "spinradar/io/scan_folder.hpp"
+#include "spinradar/io/scan_io.hpp"
 #ifdef SPINRADAR_HAVE_SIM
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
@@ -108,6 +112,57 @@ std::pair<PolarScan, PolarScan> scanPair(const BenchArgs& a, std::string& source
 #endif
 }
 
+/// The pair's second scan as an Oxford-layout PNG: the file itself when --input holds PNGs, else
+/// encoded in memory as saveOxfordPng writes it (OpenCV, compression 1, Sub filter).
+std::vector<uint8_t> pairPng(const BenchArgs& a, const PolarScan& s2) {
+  std::vector<uint8_t> bytes;
+  if (!a.input.empty()) {
+    const ScanFolder folder(a.input, parseScanFormat(a.format));
+    const std::string& p = folder.path(a.first + 1);
+    if (p.size() > 4 && p.compare(p.size() - 4, 4, ".png") == 0) {
+      readFileBytes(p, bytes);
+      return bytes;
+    }
+  }
+  cv::Mat img;
+  encodeOxfordImage(s2, img);
+  cv::imencode(".png", img, bytes, {cv::IMWRITE_PNG_COMPRESSION, 1});
+  return bytes;
+}
+
+/// Decode time of each PNG decoder on `png` (ms per image), and whether each gives OpenCV's bytes.
+struct DecodeTimes {
+  std::vector<std::pair<PngDecoder, std::vector<double>>> ms, cpu;
+  std::vector<bool> exact;
+};
+DecodeTimes benchDecoders(const std::vector<uint8_t>& png, int warmup, int runs) {
+  DecodeTimes out;
+  PngGray8Decoder reference(PngDecoder::OpenCV);
+  cv::Mat ref;
+  reference.decode(png.data(), png.size(), ref);
+  ref = ref.clone();
+  for (PngDecoder m : {PngDecoder::OpenCV, PngDecoder::Spng, PngDecoder::Deflate}) {
+    PngGray8Decoder dec(m);
+    std::vector<double> t, c;
+    cv::Mat img;
+    bool ok = true;
+    for (int i = 0; i < warmup + runs; ++i) {
+      const auto t0 = Clock::now();
+      const double c0 = cpuMs();
+      ok &= dec.decode(png.data(), png.size(), img);
+      if (i >= warmup) {
+        t.push_back(msSince(t0));
+        c.push_back(cpuMs() - c0);
+      }
+    }
+    ok &= !ref.empty() && img.size() == ref.size() && cv::norm(img, ref, cv::NORM_INF) == 0;
+    out.ms.emplace_back(m, std::move(t));
+    out.cpu.emplace_back(m, std::move(c));
+    out.exact.push_back(ok);
+  }
+  return out;
+}
+
 void run(BenchArgs& a) {
   std::optional<tbb::global_control> limit;
   if (a.threads > 0)
@@ -189,6 +244,13 @@ void run(BenchArgs& a) {
     std::printf("%-34s %6.2f ms %6.2f ms %6.2f ms %s   %s\n", name.c_str(), s.median, s.p10,
                 s.p90, c, paper);
   };
+  const std::vector<uint8_t> png = pairPng(a, s2);
+  const DecodeTimes dt = benchDecoders(png, a.warmup, a.runs);
+  for (size_t k = 0; k < dt.ms.size(); ++k) {
+    const PngDecoder m = dt.ms[k].first;
+    std::string name = std::string("PNG decode, ") + (m == PngDecoder::Deflate ? "libdeflate (used)" : pngDecoderName(m));
+    row(name, dt.ms[k].second, dt.cpu[k].second, dt.exact[k] ? "bytes = OpenCV's" : "DIFFERS from OpenCV / not handled");
+  }
   row("detector (Cen2018)", detect, {}, "~35 ms");
   row("Cartesian image", cart, {}, "");
   row("descriptors (ORB)", describe, {}, "~5 ms");

@@ -1,13 +1,17 @@
 // `spinradar odometry`: the whole chain over a folder of scans, poses to CSV.
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <deque>
+#include <exception>
 #include <filesystem>
 #include <fstream>
-#include <future>
 #include <iostream>
 #include <memory>
+#include <mutex>
 #include <optional>
+#include <thread>
 
 #include <tbb/global_control.h>
 
@@ -30,13 +34,85 @@ struct OdometryArgs {
   cli::PipelineOptions pipeline;
 };
 
-void printStageTotals(const StageTimes& t, double load_ms, size_t scans, double wall_s) {
+/// Loads a folder's scans in order on one background thread, up to `depth` scans ahead of the
+/// consumer, so that decoding the next scans overlaps processing the current one. take() hands
+/// them out in order; a scan that failed to load rethrows its error there, at its own index,
+/// as the single-thread loop would.
+class ScanPrefetcher {
+ public:
+  struct Loaded {
+    PolarScan scan;
+    double load_ms = 0;
+    std::exception_ptr error;
+  };
+  ScanPrefetcher(const ScanFolder& folder, size_t depth)
+      : folder_(folder), depth_(std::max<size_t>(1, depth)), thread_([this] { loop(); }) {}
+  ~ScanPrefetcher() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    thread_.join();
+  }
+  /// The next scan in folder order and its load time (ms); `wait_ms` += time spent waiting.
+  std::pair<PolarScan, double> take(double& wait_ms) {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait(lock, [this] { return !ready_.empty(); });
+    Loaded item = std::move(ready_.front());
+    ready_.pop_front();
+    lock.unlock();
+    cv_.notify_all();
+    wait_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (item.error) std::rethrow_exception(item.error);
+    return {std::move(item.scan), item.load_ms};
+  }
+
+ private:
+  void loop() {
+    for (size_t i = 0; i < folder_.size(); ++i) {
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait(lock, [this] { return stop_ || ready_.size() < depth_; });
+        if (stop_) return;
+      }
+      Loaded item;
+      const auto t0 = std::chrono::steady_clock::now();
+      try {
+        item.scan = folder_.load(i);
+      } catch (...) {
+        item.error = std::current_exception();
+      }
+      item.load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      const bool failed = static_cast<bool>(item.error);
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        ready_.push_back(std::move(item));
+      }
+      cv_.notify_all();
+      if (failed) return;
+    }
+  }
+
+  const ScanFolder& folder_;
+  const size_t depth_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<Loaded> ready_;
+  bool stop_ = false;
+  std::thread thread_;  // last: starts once the members above exist
+};
+
+void printStageTotals(const StageTimes& t, double load_ms, double wait_ms, bool prefetch, size_t scans,
+                      double wall_s) {
   const double n = scans > 0 ? static_cast<double>(scans) : 1.0;
   std::fprintf(stderr, "stage timing over %zu scans (total s, mean ms/scan):\n", scans);
   auto row = [&](const char* name, double ms) {
     std::fprintf(stderr, "  %-18s %9.3f s  %8.2f ms\n", name, ms / 1000.0, ms / n);
   };
-  row("load", load_ms);
+  row(prefetch ? "load (background)" : "load", load_ms);
+  if (prefetch) row("waiting for loads", wait_ms);
   row("detect", t.detect_ms);
   row("cartesian", t.cartesian_ms);
   row("describe", t.describe_ms);
@@ -99,13 +175,13 @@ void run(OdometryArgs& a) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return std::make_pair(std::move(s), ms);
   };
-  // With more than one thread the next scan is read while this one is processed.
+  // With more than one thread the next scans are read while this one is processed.
   const bool prefetch = a.threads != 1;
-  std::future<std::pair<PolarScan, double>> next;
-  if (prefetch) next = std::async(std::launch::async, timedLoad, 0);
+  double wait_ms = 0;
+  std::optional<ScanPrefetcher> prefetcher;
+  if (prefetch) prefetcher.emplace(folder, 3);
   for (size_t i = 0; i < folder.size(); ++i) {
-    auto [scan, ms] = prefetch ? next.get() : timedLoad(i);
-    if (prefetch && i + 1 < folder.size()) next = std::async(std::launch::async, timedLoad, i + 1);
+    auto [scan, ms] = prefetch ? prefetcher->take(wait_ms) : timedLoad(i);
     load_ms += ms;
     const OdometryResult r = odometry.process(scan);
     totals += r.times;
@@ -147,7 +223,7 @@ void run(OdometryArgs& a) {
   }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  printStageTotals(totals, load_ms, folder.size(), wall);
+  printStageTotals(totals, load_ms, wait_ms, prefetch, folder.size(), wall);
   if (failures)
     std::fprintf(stderr, "warning: motion estimation failed on %zu of %zu scan pairs (pose held "
                          "as the odometry reported it)\n", failures, folder.size() - 1);
