@@ -31,6 +31,14 @@ if(SPINRADAR_TOOL_SOURCES)
   target_link_libraries(spinradar_cli PRIVATE ${SPINRADAR_ALL_PARTS} CLI11::CLI11 yaml-cpp)
   target_include_directories(spinradar_cli PRIVATE ${PROJECT_SOURCE_DIR}/src/tools
     ${PROJECT_SOURCE_DIR}/src/bag)
+  # `bench` compares with OpenCV's PNG decoder, loaded at run time: linking opencv_imgcodecs
+  # would cost every run 0.3 s of start-up (include/spinradar/io/png_io.hpp).
+  get_target_property(_imgcodecs_so opencv_imgcodecs IMPORTED_SONAME_RELEASE)
+  if(NOT _imgcodecs_so)
+    set(_imgcodecs_so "libopencv_imgcodecs.so")
+  endif()
+  target_compile_definitions(spinradar_cli PRIVATE SPINRADAR_IMGCODECS_SO="${_imgcodecs_so}")
+  target_link_libraries(spinradar_cli PRIVATE ${CMAKE_DL_LIBS})
   foreach(lib spinradar_bag)
     if(TARGET ${lib})
       target_link_libraries(spinradar_cli PRIVATE ${lib})

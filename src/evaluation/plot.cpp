@@ -6,8 +6,9 @@
 #include <limits>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "spinradar/io/png_io.hpp"
 
 namespace spinradar::plot {
 
@@ -388,13 +389,13 @@ cv::Mat tile(const std::vector<cv::Mat>& panels, int cols) {
 }
 
 void saveImage(const cv::Mat& image, const std::string& path) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, image);
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(path + ": cannot write image: " + e.what());
-  }
-  if (!ok) throw std::runtime_error(path + ": cannot write image (bad folder or extension?)");
+  // PNG only, through io's libspng writer: OpenCV's imgcodecs would cost every process 0.3 s
+  // of start-up (see io/png_io.hpp).
+  const auto dot = path.rfind('.');
+  std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  if (ext != ".png") throw std::runtime_error(path + ": cannot write image (only .png plots are written)");
+  writePng(image, path, 3);  // errors name the file
 }
 
 }  // namespace spinradar::plot

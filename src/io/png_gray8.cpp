@@ -8,8 +8,6 @@
 #include <libdeflate.h>
 #include <spng.h>
 
-#include <opencv2/imgcodecs.hpp>
-
 #if defined(__SSSE3__)
 #include <tmmintrin.h>
 #endif
@@ -19,7 +17,7 @@ namespace spinradar {
 namespace {
 
 constexpr uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-/// Larger images go to OpenCV, which has its own limits.
+/// Larger images are refused (libspng then applies its own limits).
 constexpr uint64_t kMaxPixelBytes = uint64_t(1) << 30;
 
 uint32_t be32(const uint8_t* p) {
@@ -67,7 +65,7 @@ bool scanChunks(const uint8_t* png, size_t size, Header& h, std::vector<uint8_t>
     } else if (isType(type, "IEND")) {
       return have_ihdr && have_idat;
     } else if (!harmlessAncillary(type)) {
-      return false;  // PLTE, tRNS, gAMA, unknown critical chunks...: OpenCV decides
+      return false;  // PLTE, tRNS, gAMA, unknown critical chunks...: not handled here
     }
     if (have_idat && !isType(type, "IDAT")) idat_done = true;
     pos += size_t(len) + 12;
@@ -138,8 +136,7 @@ struct PngGray8Decoder::Inflater {
 const char* pngDecoderName(PngDecoder decoder) {
   switch (decoder) {
     case PngDecoder::Deflate: return "libdeflate + own unfilter";
-    case PngDecoder::Spng: return "libspng";
-    default: return "OpenCV imdecode";
+    default: return "libspng";
   }
 }
 
@@ -170,15 +167,7 @@ bool PngGray8Decoder::decode(const uint8_t* png, size_t size, cv::Mat& image) {
   image.release();
   switch (method_) {
     case PngDecoder::Deflate: return decodeDeflate(png, size, image);
-    case PngDecoder::Spng: return decodeSpng(png, size, image);
-    default:
-      try {
-        image = cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(png)),
-                             cv::IMREAD_UNCHANGED);
-      } catch (const cv::Exception&) {
-        image.release();
-      }
-      return !image.empty();
+    default: return decodeSpng(png, size, image);
   }
 }
 
@@ -189,7 +178,7 @@ bool PngGray8Decoder::decodeDeflate(const uint8_t* png, size_t size, cv::Mat& im
   pixels_.resize(stride * h.height);
   if (libdeflate_zlib_decompress(inflater_->d, idat_.data(), idat_.size(), pixels_.data(), pixels_.size(),
                                  nullptr) != LIBDEFLATE_SUCCESS)
-    return false;  // corrupt, short or long data: OpenCV gives its own verdict
+    return false;  // corrupt, short or long data: refused
   // The row above the first is zeros: give Up/Average/Paeth a zero row to read.
   static const std::vector<uint8_t> zeros(1 << 16, 0);
   std::vector<uint8_t> wide_zeros;

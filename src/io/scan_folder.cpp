@@ -6,9 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "scan_io_detail.hpp"
+#include "spinradar/io/png_io.hpp"
 #include "spinradar/io/scan_io.hpp"
 
 namespace fs = std::filesystem;
@@ -31,8 +30,13 @@ bool pngSize(const std::string& path, int& width, int& height) {
 /// First row's embedded microsecond stamp of a Navtech-layout PNG (columns 0-7, int64 LE), for
 /// files whose name is not a stamp (e.g. Boreas-RT's test_frame.png).
 bool embeddedStampNs(const std::string& path, int64_t& ns) {
-  const cv::Mat img = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (img.empty() || img.type() != CV_8UC1 || img.cols < 8) return false;
+  cv::Mat img;
+  try {
+    img = readPngGray8(path);
+  } catch (const std::runtime_error&) {
+    return false;
+  }
+  if (img.empty() || img.cols < 8) return false;
   int64_t us = 0;
   for (int k = 7; k >= 0; --k) us = (us << 8) | img.at<uint8_t>(0, k);
   ns = us * 1000;

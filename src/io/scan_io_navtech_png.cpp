@@ -7,9 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
-
-#include "spinradar/io/png_gray8.hpp"
+#include "spinradar/io/png_io.hpp"
 #include "spinradar/io/scan_io.hpp"
 #include "scan_io_detail.hpp"
 
@@ -94,38 +92,16 @@ PolarScan decodeRows(const cv::Mat& img, const std::string& name, double resolut
   return scan;
 }
 
-/// The returned image may point into this thread's decoder buffer: use it before the next call.
-cv::Mat readGray(const std::string& path) {
-  thread_local std::vector<uint8_t> bytes;
-  thread_local PngGray8Decoder fast;  // exact OpenCV output, several times faster; else OpenCV
-  readFileBytes(path, bytes);
-  static const uint8_t png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (bytes.size() < 8 || std::memcmp(bytes.data(), png_sig, 8) != 0)
-    throw std::runtime_error(path + ": not a PNG file (bad signature)");
-  cv::Mat img;
-  if (fast.decode(bytes.data(), bytes.size(), img)) return img;
-  try {
-    img = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data()), cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(path + ": unreadable PNG (" + e.what() + ")");
-  }
-  if (img.empty()) throw std::runtime_error(path + ": unreadable PNG (corrupt or truncated)");
-  return img;
-}
+/// The returned image points into this thread's decoder buffer: use it before the next call.
+cv::Mat readGray(const std::string& path) { return readPngGray8(path); }
 
-void writePng(const cv::Mat& img, const std::string& path) {
+void writeScanPng(const cv::Mat& img, const std::string& path) {
   const auto dot = path.rfind('.');
   std::string ext = dot == std::string::npos ? "" : path.substr(dot);
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
   if (ext != ".png")
     throw std::runtime_error(path + ": the polar layout needs a lossless .png file name");
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, img, {cv::IMWRITE_PNG_COMPRESSION, 1});
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(path + ": cannot write PNG (" + e.what() + ")");
-  }
-  if (!ok) throw std::runtime_error(path + ": cannot write PNG");
+  writePng(img, path, 1);
 }
 
 void encodeRows(const PolarScan& scan, cv::Mat& img, bool chirp_column) {
@@ -192,7 +168,7 @@ void saveOxfordPng(const PolarScan& scan, const std::string& path) {
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(path + ": " + e.what());
   }
-  writePng(img, path);
+  writeScanPng(img, path);
 }
 
 PolarScan loadBoreasPng(const std::string& path, double range_offset) {
@@ -222,7 +198,7 @@ void saveBoreasPng(const PolarScan& scan, const std::string& path) {
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(path + ": " + e.what());
   }
-  writePng(img, path);
+  writeScanPng(img, path);
 }
 
 int64_t boreasFileStampUs(const PolarScan& scan) {

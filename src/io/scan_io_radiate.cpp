@@ -4,27 +4,15 @@
 #include <stdexcept>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
+#include "spinradar/io/png_io.hpp"
 #include "spinradar/io/scan_io.hpp"
 
 namespace spinradar {
 
 PolarScan loadRadiatePng(const std::string& path, int64_t scan_stamp_ns, double rotation_hz,
                          double range_resolution, double range_offset) {
-  cv::Mat img;
-  try {
-    img = cv::imread(path, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(path + ": unreadable PNG (" + e.what() + ")");
-  }
-  if (img.empty()) throw std::runtime_error(path + ": cannot read image (missing, corrupt or not a PNG)");
-  if (img.depth() != CV_8U || img.channels() != 1) {
-    std::ostringstream s;
-    s << path << ": " << img.channels() << " channel(s) of " << img.elemSize1() * 8
-      << "-bit, an 8-bit single-channel image expected";
-    throw std::runtime_error(s.str());
-  }
+  const cv::Mat img = readPngGray8(path);  // names the file and the reason when it cannot
   if (rotation_hz <= 0) throw std::runtime_error(path + ": rotation_hz must be positive");
   PolarScan scan;
   scan.resize(img.cols, img.rows);

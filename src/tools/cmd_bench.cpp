@@ -1,4 +1,5 @@
 // `spinradar bench`: per-stage timings and peak memory on a full-size scan pair.
+#include <dlfcn.h>
 #include <sys/resource.h>
 #include <time.h>
 
@@ -14,7 +15,6 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <tbb/global_control.h>
 
 #include "command.hpp"
@@ -23,6 +23,7 @@
 #include "spinradar/features/matcher.hpp"
 #include "spinradar/estimation/odometry.hpp"
 #include "spinradar/io/png_gray8.hpp"
+#include "spinradar/io/png_io.hpp"
 #include "spinradar/io/scan_folder.hpp"
 #include "spinradar/io/scan_io.hpp"
 #ifdef SPINRADAR_HAVE_SIM
@@ -113,7 +114,7 @@ std::pair<PolarScan, PolarScan> scanPair(const BenchArgs& a, std::string& source
 }
 
 /// The pair's second scan as an Oxford-layout PNG: the file itself when --input holds PNGs, else
-/// encoded in memory as saveOxfordPng writes it (OpenCV, compression 1, Sub filter).
+/// encoded in memory as saveOxfordPng writes it (zlib level 1, Sub filter).
 std::vector<uint8_t> pairPng(const BenchArgs& a, const PolarScan& s2) {
   std::vector<uint8_t> bytes;
   if (!a.input.empty()) {
@@ -126,38 +127,52 @@ std::vector<uint8_t> pairPng(const BenchArgs& a, const PolarScan& s2) {
   }
   cv::Mat img;
   encodeOxfordImage(s2, img);
-  cv::imencode(".png", img, bytes, {cv::IMWRITE_PNG_COMPRESSION, 1});
+  encodePng(img, bytes, 1);
   return bytes;
 }
 
-/// Decode time of each PNG decoder on `png` (ms per image), and whether each gives OpenCV's bytes.
+/// OpenCV's cv::imdecode, loaded at run time (not linked: see io/png_io.hpp); null if absent.
+using Imdecode = cv::Mat (*)(const cv::_InputArray&, int);
+Imdecode openCvImdecode() {
+  void* lib = dlopen(SPINRADAR_IMGCODECS_SO, RTLD_NOW | RTLD_LOCAL);
+  return lib ? reinterpret_cast<Imdecode>(dlsym(lib, "_ZN2cv8imdecodeERKNS_11_InputArrayEi")) : nullptr;
+}
+
+/// Decode time of each PNG decoder on `png` (wall and CPU ms per image) and whether each gives
+/// OpenCV's bytes.
 struct DecodeTimes {
-  std::vector<std::pair<PngDecoder, std::vector<double>>> ms, cpu;
+  std::vector<std::string> name;
+  std::vector<std::vector<double>> ms, cpu;
   std::vector<bool> exact;
 };
 DecodeTimes benchDecoders(const std::vector<uint8_t>& png, int warmup, int runs) {
   DecodeTimes out;
-  PngGray8Decoder reference(PngDecoder::OpenCV);
+  const Imdecode imdecode = openCvImdecode();
+  const cv::Mat wrapped(1, static_cast<int>(png.size()), CV_8UC1, const_cast<uint8_t*>(png.data()));
   cv::Mat ref;
-  reference.decode(png.data(), png.size(), ref);
-  ref = ref.clone();
-  for (PngDecoder m : {PngDecoder::OpenCV, PngDecoder::Spng, PngDecoder::Deflate}) {
-    PngGray8Decoder dec(m);
+  if (imdecode) ref = imdecode(wrapped, -1 /* cv::IMREAD_UNCHANGED */);
+  PngGray8Decoder spng(PngDecoder::Spng), deflate(PngDecoder::Deflate);
+  const std::vector<std::pair<std::string, std::function<bool(cv::Mat&)>>> decoders = {
+      {"OpenCV imdecode", [&](cv::Mat& m) { return imdecode && !(m = imdecode(wrapped, -1)).empty(); }},
+      {pngDecoderName(PngDecoder::Spng), [&](cv::Mat& m) { return spng.decode(png.data(), png.size(), m); }},
+      {"libdeflate (used)", [&](cv::Mat& m) { return deflate.decode(png.data(), png.size(), m); }}};
+  for (const auto& [name, decode] : decoders) {
     std::vector<double> t, c;
     cv::Mat img;
     bool ok = true;
     for (int i = 0; i < warmup + runs; ++i) {
       const auto t0 = Clock::now();
       const double c0 = cpuMs();
-      ok &= dec.decode(png.data(), png.size(), img);
+      ok &= decode(img);
       if (i >= warmup) {
         t.push_back(msSince(t0));
         c.push_back(cpuMs() - c0);
       }
     }
-    ok &= !ref.empty() && img.size() == ref.size() && cv::norm(img, ref, cv::NORM_INF) == 0;
-    out.ms.emplace_back(m, std::move(t));
-    out.cpu.emplace_back(m, std::move(c));
+    ok &= !ref.empty() && img.size() == ref.size() && img.type() == ref.type() && cv::norm(img, ref, cv::NORM_INF) == 0;
+    out.name.push_back(name);
+    out.ms.push_back(std::move(t));
+    out.cpu.push_back(std::move(c));
     out.exact.push_back(ok);
   }
   return out;
@@ -246,11 +261,9 @@ void run(BenchArgs& a) {
   };
   const std::vector<uint8_t> png = pairPng(a, s2);
   const DecodeTimes dt = benchDecoders(png, a.warmup, a.runs);
-  for (size_t k = 0; k < dt.ms.size(); ++k) {
-    const PngDecoder m = dt.ms[k].first;
-    std::string name = std::string("PNG decode, ") + (m == PngDecoder::Deflate ? "libdeflate (used)" : pngDecoderName(m));
-    row(name, dt.ms[k].second, dt.cpu[k].second, dt.exact[k] ? "bytes = OpenCV's" : "DIFFERS from OpenCV / not handled");
-  }
+  for (size_t k = 0; k < dt.ms.size(); ++k)
+    row("PNG decode, " + dt.name[k], dt.ms[k], dt.cpu[k],
+        dt.exact[k] ? "bytes = OpenCV's" : "DIFFERS from OpenCV (or OpenCV not found)");
   row("detector (Cen2018)", detect, {}, "~35 ms");
   row("Cartesian image", cart, {}, "");
   row("descriptors (ORB)", describe, {}, "~5 ms");

@@ -1,6 +1,7 @@
 // The fast PNG decoders give exactly OpenCV's bytes: on Oxford-layout scans written by the
 // project (simulated city scans), on every PNG row filter, on the real Oxford sample, and they
-// hand anything else (colour, 16-bit, damaged files) back to OpenCV.
+// refuse anything else (colour, 16-bit, damaged files). The libspng writer (plots, scans) gives
+// back what OpenCV reads.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -12,6 +13,7 @@
 #include <spng.h>
 
 #include "spinradar/io/png_gray8.hpp"
+#include "spinradar/io/png_io.hpp"
 #include "spinradar/io/scan_io.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
@@ -135,7 +137,7 @@ TEST(PngDecode, EveryRowFilterAndCompressionLevel) {
   }
 }
 
-TEST(PngDecode, OtherKindsAndDamagedFilesGoBackToOpenCv) {
+TEST(PngDecode, OtherKindsAndDamagedFilesAreRefusedByTheFastPath) {
   std::vector<uint8_t> buf;
   auto encode = [&](const cv::Mat& m) {
     cv::imencode(".png", m, buf);
@@ -172,4 +174,28 @@ TEST(PngDecode, RealOxfordScansDecodeExactlyAsOpenCv) {
     ++n;
   }
   EXPECT_GE(n, 3);
+}
+
+TEST(PngDecode, WriterRoundTripsThroughOpenCv) {
+  TempDir d;
+  cv::Mat bgr(31, 45, CV_8UC3), bgra(7, 9, CV_8UC4), gray(13, 70, CV_8UC1);
+  cv::randu(bgr, 0, 256);
+  cv::randu(bgra, 0, 256);
+  cv::randu(gray, 0, 256);
+  for (const cv::Mat& m : {bgr, bgra, gray}) {
+    const std::string path = d.file("w" + std::to_string(m.channels()) + ".png");
+    writePng(m, path, 6);
+    const cv::Mat back = cv::imread(path, cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(back.type(), m.type()) << m.channels() << " channels";
+    EXPECT_EQ(cv::norm(back, m, cv::NORM_INF), 0) << m.channels() << " channels (BGR order kept)";
+  }
+  EXPECT_EQ(differences(readPngGray8(d.file("w1.png")), gray), 0);
+  try {
+    readPngGray8(d.file("w3.png"));
+    ADD_FAILURE() << "colour accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("w3.png: 3 channel(s) of 8-bit"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(writePng(gray, d.file("no/such/folder/x.png")), std::runtime_error);
+  EXPECT_FALSE(fs::exists(d.file("no/such/folder/x.png.tmp")));
 }

@@ -53,7 +53,7 @@ class Plot {
 
   /// Renders the axes to a BGR image of the given size (white background).
   cv::Mat render(int width = 800, int height = 600) const;
-  /// render() + cv::imwrite; throws std::runtime_error naming the file on failure.
+  /// render() + saveImage; throws std::runtime_error naming the file on failure.
   void save(const std::string& path, int width = 800, int height = 600) const;
 
   const std::vector<Series>& series() const { return series_; }
@@ -70,7 +70,7 @@ std::vector<double> niceTicks(double lo, double hi, int target = 6);
 
 /// Tiles panels (all resized to the first panel's size) into `cols` columns.
 cv::Mat tile(const std::vector<cv::Mat>& panels, int cols);
-/// cv::imwrite with an error naming the file.
+/// Writes a .png (8-bit, 1/3/4 channels) with an error naming the file.
 void saveImage(const cv::Mat& image, const std::string& path);
 
 }  // namespace spinradar::plot

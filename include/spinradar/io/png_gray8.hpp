@@ -7,7 +7,7 @@
 // SSE prefix sums). Every row and column is needed (metadata and bins up to the last one reach
 // the Cartesian image), so nothing is skipped. Anything it does not handle byte for byte as
 // OpenCV (colour, 16-bit, palette, interlace, tRNS, unknown or damaged chunks, CRC or Adler
-// mismatches, short or long data) is left to OpenCV, so results and errors stay OpenCV's.
+// mismatches, short or long data) is refused, so that what it returns is always OpenCV's.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -20,7 +20,6 @@ namespace spinradar {
 enum class PngDecoder {
   Deflate,  ///< own chunk parser + libdeflate + one in-place unfilter pass (fastest, default)
   Spng,     ///< libspng (zlib inflate inside)
-  OpenCV,   ///< cv::imdecode (libpng + zlib)
 };
 const char* pngDecoderName(PngDecoder decoder);
 
@@ -40,8 +39,7 @@ class PngGray8Decoder {
   /// Decodes an 8-bit grayscale, non-interlaced PNG held in memory. On success `image` is a
   /// CV_8UC1 header over this decoder's buffer, valid until the next call (copy it to keep it).
   /// Returns false, leaving `image` empty, when this PNG is one the method does not handle
-  /// exactly as OpenCV (see the file comment): decode it with cv::imdecode instead.
-  /// PngDecoder::OpenCV always decodes with cv::imdecode (empty image when it fails).
+  /// exactly as OpenCV (see the file comment): readPngGray8 (png_io.hpp) then uses libspng.
   bool decode(const uint8_t* png, size_t size, cv::Mat& image);
 
  private:
