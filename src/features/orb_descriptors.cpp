@@ -5,6 +5,9 @@
 #include <cstring>
 #include <stdexcept>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
 namespace spinradar {
 
 namespace {
@@ -32,8 +35,15 @@ OrbDescriber::OrbDescriber(int patch_size, bool oriented) : oriented_(oriented) 
 void OrbDescriber::setPatchSize(int patch_size) {
   if (patch_size < 5) throw std::invalid_argument("OrbDescriber: patch size must be >= 5");
   patch_size_ = patch_size;
-  // One pyramid level: radar keypoints come with their own positions and a fixed scale.
-  orb_ = cv::ORB::create(500, 1.2f, 1, patch_size, 0, 2, cv::ORB::HARRIS_SCORE, patch_size);
+  // cv::ORB's test pattern for patch sizes other than 31: 512 points drawn by its fixed-seed RNG.
+  pattern_.resize(512);
+  cv::RNG rng(0x34985739);
+  for (auto& p : pattern_) {
+    p.x = rng.uniform(-patch_size / 2, patch_size / 2 + 1);
+    p.y = rng.uniform(-patch_size / 2, patch_size / 2 + 1);
+  }
+  offsets_step_ = 0;
+  orb_.reset();
   // Circular patch of radius patch/2: umax[v] = half width of row v (symmetric, as ORB builds it).
   const int half = patch_size / 2;
   umax_.assign(half + 2, 0);
@@ -70,30 +80,87 @@ float icAngle(const cv::Mat& img, int u, int v, int half, const std::vector<int>
 
 void OrbDescriber::describe(const cv::Mat& image, const CartesianProjector& projector,
                             std::vector<Keypoint>& keypoints, cv::Mat& descriptors) {
-  cv_kps_.clear();
-  cv_kps_.reserve(keypoints.size());
-  for (size_t i = 0; i < keypoints.size(); ++i) {
-    const cv::Point2f px = projector.toPixel(keypoints[i].x, keypoints[i].y);
-    // class_id carries the index through ORB, which drops keypoints near the border.
-    cv_kps_.emplace_back(px, static_cast<float>(patch_size_), -1.f, keypoints[i].power, 0, static_cast<int>(i));
-  }
-  if (cv_kps_.empty()) {
+  const int W = image.cols, H = image.rows, half = patch_size_ / 2;
+  if (keypoints.empty() || W <= 2 * patch_size_ || H <= 2 * patch_size_) {
     keypoints.clear();
     resizeRows(descriptors, 0, 32);
     return;
   }
-  if (oriented_) {
-    const int half = patch_size_ / 2;
-    for (auto& k : cv_kps_) {
-      const int u = cvRound(k.pt.x), v = cvRound(k.pt.y);
-      if (u >= half && v >= half && u + half < image.cols && v + half < image.rows)
-        k.angle = icAngle(image, u, v, half, umax_);
-      else
-        k.angle = 0.f;  // ORB drops it anyway (closer than the edge threshold)
-    }
-  } else {
-    for (auto& k : cv_kps_) k.angle = 0.f;
+  if (use_opencv_ || patch_size_ == 31) {  // 31: ORB's built-in pattern, not rebuilt here
+    describeWithOpenCv(image, projector, keypoints, descriptors);
+    return;
   }
+  // Blur exactly as cv::ORB does: a copy with a reflected border of ORB's width, then the same
+  // GaussianBlur call on the image inside it (the border supplies the neighbours).
+  const int border = std::max(patch_size_, std::max(static_cast<int>(std::ceil(half * std::sqrt(2.0))), 4)) + 1;
+  bordered_.create(H + 2 * border, (W + 2 * border + 15) & ~15, CV_8UC1);
+  cv::Mat ext = bordered_(cv::Rect(0, 0, W + 2 * border, H + 2 * border));
+  cv::copyMakeBorder(image, ext, border, border, border, border, cv::BORDER_REFLECT_101);
+  cv::Mat blurred = ext(cv::Rect(border, border, W, H));
+  cv::GaussianBlur(blurred, blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+
+  const int step = static_cast<int>(blurred.step);
+  if (offsets_step_ != blurred.step) {
+    offsets_.resize(pattern_.size());
+    for (size_t i = 0; i < pattern_.size(); ++i) offsets_[i] = pattern_[i].y * step + pattern_[i].x;
+    offsets_step_ = blurred.step;
+  }
+  kept_.clear();
+  kept_.reserve(keypoints.size());
+  resizeRows(descriptors, static_cast<int>(keypoints.size()), 32);
+  int rows = 0;
+  for (const Keypoint& kp : keypoints) {
+    const cv::Point2f px = projector.toPixel(kp.x, kp.y);
+    // ORB's edge filter: the rounded pixel at least patch_size from every border.
+    const int u = cvRound(px.x), v = cvRound(px.y);
+    if (u < patch_size_ || u >= W - patch_size_ || v < patch_size_ || v >= H - patch_size_) continue;
+    const uint8_t* c = blurred.ptr<uint8_t>(v) + u;
+    uint8_t* d = descriptors.ptr<uint8_t>(rows++);
+    if (!oriented_) {
+      const int* o = offsets_.data();
+      for (int i = 0; i < 32; ++i, o += 16) {
+        int val = 0;
+        for (int j = 0; j < 8; ++j) val |= (c[o[2 * j]] < c[o[2 * j + 1]]) << j;
+        d[i] = static_cast<uint8_t>(val);
+      }
+    } else {
+      // As ORB's rotated tests, in the same float operations.
+      float angle = icAngle(image, u, v, half, umax_);
+      angle *= static_cast<float>(CV_PI / 180.f);
+      const float a = static_cast<float>(std::cos(angle)), b = static_cast<float>(std::sin(angle));
+      auto value = [&](const cv::Point& p) {
+        const float x = p.x * a - p.y * b, y = p.x * b + p.y * a;
+        return c[cvRound(y) * step + cvRound(x)];
+      };
+      const cv::Point* p = pattern_.data();
+      for (int i = 0; i < 32; ++i, p += 16) {
+        int val = 0;
+        for (int j = 0; j < 8; ++j) val |= (value(p[2 * j]) < value(p[2 * j + 1])) << j;
+        d[i] = static_cast<uint8_t>(val);
+      }
+    }
+    kept_.push_back(kp);
+  }
+  resizeRows(descriptors, rows, 32);
+  keypoints.swap(kept_);
+}
+
+void OrbDescriber::describeWithOpenCv(const cv::Mat& image, const CartesianProjector& projector,
+                                      std::vector<Keypoint>& keypoints, cv::Mat& descriptors) {
+  cv_kps_.clear();
+  cv_kps_.reserve(keypoints.size());
+  const int half = patch_size_ / 2;
+  for (size_t i = 0; i < keypoints.size(); ++i) {
+    const cv::Point2f px = projector.toPixel(keypoints[i].x, keypoints[i].y);
+    // class_id carries the index through ORB, which drops keypoints near the border.
+    cv::KeyPoint k(px, static_cast<float>(patch_size_), 0.f, keypoints[i].power, 0, static_cast<int>(i));
+    const int u = cvRound(px.x), v = cvRound(px.y);
+    if (oriented_ && u >= half && v >= half && u + half < image.cols && v + half < image.rows)
+      k.angle = icAngle(image, u, v, half, umax_);
+    cv_kps_.push_back(k);
+  }
+  // One pyramid level: radar keypoints come with their own positions and a fixed scale.
+  if (!orb_) orb_ = cv::ORB::create(500, 1.2f, 1, patch_size_, 0, 2, cv::ORB::HARRIS_SCORE, patch_size_);
   orb_->compute(image, cv_kps_, raw_);
   kept_.clear();
   kept_.reserve(cv_kps_.size());

@@ -10,6 +10,11 @@
 
 namespace spinradar {
 
+/// Gives exactly cv::ORB::compute's descriptors (one level, WTA_K 2, edge threshold = patch
+/// size; tested byte for byte) without its per-call image pyramid, keypoint copies and
+/// allocations: the image is blurred as ORB blurs it (the same cv::GaussianBlur call on a
+/// bordered copy), then each descriptor is 256 comparisons at precomputed offsets. Patch size
+/// 31 uses ORB's built-in test pattern, which is not rebuilt here: that size goes to cv::ORB.
 class OrbDescriber {
  public:
   /// `patch_size`: ORB patch in pixels (odd). Keypoints closer than the patch size to the image
@@ -23,6 +28,9 @@ class OrbDescriber {
   explicit OrbDescriber(int patch_size = 21, bool oriented = false);
   void setPatchSize(int patch_size);
   void setOriented(bool oriented) { oriented_ = oriented; }
+  /// Computes through cv::ORB::compute instead (always so for patch size 31). Both give the same
+  /// descriptors; the switch exists so that tests compare the two.
+  void setUseOpenCv(bool use) { use_opencv_ = use; }
 
   /// Computes one 32-byte ORB descriptor per keypoint at its pixel on `image` (as placed by
   /// `projector`). Keypoints without a descriptor (patch off the image) are removed from
@@ -31,12 +39,20 @@ class OrbDescriber {
                 cv::Mat& descriptors);
 
  private:
+  void describeWithOpenCv(const cv::Mat& image, const CartesianProjector& projector,
+                          std::vector<Keypoint>& keypoints, cv::Mat& descriptors);
+
   int patch_size_ = 21;
   bool oriented_ = false;
   std::vector<int> umax_;  ///< half widths of the circular patch per row (ORB's IC angle)
-  cv::Ptr<cv::ORB> orb_;
-  std::vector<cv::KeyPoint> cv_kps_;
+  std::vector<cv::Point> pattern_;  ///< ORB's 512 test points for this patch size (256 pairs)
+  std::vector<int> offsets_;        ///< pattern_ as byte offsets for `offsets_step_`
+  size_t offsets_step_ = 0;
+  cv::Mat bordered_;  ///< image + reflected border, blurred in place inside the border
   std::vector<Keypoint> kept_;
+  bool use_opencv_ = false;
+  cv::Ptr<cv::ORB> orb_;  ///< created on first use of the OpenCV path
+  std::vector<cv::KeyPoint> cv_kps_;
   cv::Mat raw_;
 };
 
