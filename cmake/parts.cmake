@@ -28,6 +28,9 @@ spinradar_part(evaluation   USES io core  LIBS opencv_imgproc)
 spinradar_part(localization USES estimation features evaluation io core)
 spinradar_part(sim          USES driver io features evaluation core
                             LIBS nlohmann_json::nlohmann_json TBB::tbb Threads::Threads)
+# Calibrated sensor files (config/sensors/<name>.json) are found by name: `--sensor oxford`.
+target_compile_definitions(spinradar_sim PRIVATE
+                           SPINRADAR_SENSORS_DIR="${PROJECT_SOURCE_DIR}/config/sensors")
 spinradar_part(diagnose     USES sim evaluation io features core LIBS nlohmann_json::nlohmann_json)
 target_include_directories(spinradar_core PUBLIC ${OpenCV_INCLUDE_DIRS})
 

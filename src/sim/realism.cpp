@@ -28,14 +28,55 @@ struct Corr {
 
 }  // namespace
 
+void countPlainCaCfar(const PolarScan& s, double min_range, double max_range, double per_band[4]) {
+  constexpr int kTrain = 16, kGuard = 4;
+  const double alpha = std::pow(10.0, 1.2);
+  std::vector<double> lin(size_t(s.bins)), cum(size_t(s.bins) + 1);
+  const int b0 = std::max(kTrain + kGuard, int(std::ceil(s.binOfRange(min_range))));
+  const int b1 = std::min(s.bins - 1 - kTrain - kGuard, int(std::floor(s.binOfRange(max_range))));
+  for (int a = 0; a < s.azimuths; ++a) {
+    if (!s.valid.empty() && !s.valid[a]) continue;
+    const uint8_t* row = s.row(a);
+    cum[0] = 0;
+    for (int b = 0; b < s.bins; ++b) {
+      lin[b] = std::pow(10.0, row[b] / 10.0);
+      cum[b + 1] = cum[b] + lin[b];
+    }
+    for (int b = b0; b <= b1; ++b) {
+      double train = cum[b - kGuard] - cum[b - kGuard - kTrain] + cum[b + kGuard + kTrain + 1] -
+                     cum[b + kGuard + 1];
+      if (lin[b] <= alpha * train / (2 * kTrain)) continue;
+      double r = s.rangeOfBin(b);
+      for (int k = 0; k < 4; ++k)
+        if (r >= kBandEdges[k] && r < kBandEdges[k + 1]) per_band[k] += 1;
+    }
+  }
+}
+
+std::vector<double> bandGaps(const RealismStats& sim, const RealismStats& real) {
+  std::vector<double> g;
+  auto rel = [&](double s, double r) {
+    g.push_back(r > 0 ? std::abs(s - r) / r : (s > 0 ? 1.0 : 0.0));
+  };
+  for (int k = 0; k < 4; ++k) {
+    rel(sim.band_mean[k], real.band_mean[k]);
+    rel(sim.band_q90[k], real.band_q90[k]);
+    rel(sim.band_cacfar[k], real.band_cacfar[k]);
+    if (sim.band_cen[k] >= 0 && real.band_cen[k] >= 0) rel(sim.band_cen[k], real.band_cen[k]);
+  }
+  return g;
+}
+
 RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::string& name,
                             const RealismOptions& o) {
   RealismStats st;
   st.name = name;
   st.scans = int(scans.size());
   std::vector<double> hist(256, 0.0);
+  std::vector<std::vector<double>> band_hist(4, std::vector<double>(256, 0.0));
+  double cacfar[4] = {0, 0, 0, 0}, cen_band[4] = {0, 0, 0, 0};
   double band_sum[4] = {0, 0, 0, 0}, band_n[4] = {0, 0, 0, 0};
-  const double band_edge[5] = {2.5, 10, 25, 50, 100};
+  const double* band_edge = kBandEdges;
   Corr az, rs, rl;
   double det_cen = 0, det_cfar = 0;
   std::vector<Keypoint> kps;
@@ -52,7 +93,10 @@ RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::stri
         hist[row[b]] += 1;
         double r = s.rangeOfBin(b);
         for (int k = 0; k < 4; ++k)
-          if (r >= band_edge[k] && r < band_edge[k + 1]) band_sum[k] += row[b], band_n[k] += 1;
+          if (r >= band_edge[k] && r < band_edge[k + 1]) {
+            band_sum[k] += row[b], band_n[k] += 1;
+            band_hist[k][row[b]] += 1;
+          }
         // Subsample the texture statistics (every 3rd cell) to keep this fast.
         if (b % 3 == 0) {
           az.add(row[b], next[b]);
@@ -69,11 +113,30 @@ RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::stri
       Detector d(dc);
       d.detect(s, kps);
       det_cen += kps.size();
+      for (const Keypoint& kp : kps)
+        for (int k = 0; k < 4; ++k)
+          if (kp.range >= band_edge[k] && kp.range < band_edge[k + 1]) cen_band[k] += 1;
       dc.detector = "cfar";
       d.setConfig(dc);
       d.detect(s, kps);
       det_cfar += kps.size();
     }
+    countPlainCaCfar(s, o.min_range, o.max_range, cacfar);
+  }
+  const double ns = std::max<size_t>(scans.size(), 1);
+  for (int k = 0; k < 4; ++k) {
+    double n = 0, c = 0;
+    for (double h : band_hist[k]) n += h;
+    for (int v = 0; v < 256 && n > 0; ++v) {
+      c += band_hist[k][v];
+      if (c >= 0.9 * n) {
+        st.band_q90[k] = v;
+        break;
+      }
+    }
+    st.band_cacfar[k] = cacfar[k] / ns;
+    st.cacfar += cacfar[k] / ns;
+    if (o.detect) st.band_cen[k] = cen_band[k] / ns;
   }
   double total = 0, sum = 0;
   for (int v = 0; v < 256; ++v) total += hist[v], sum += v * hist[v];
@@ -185,11 +248,19 @@ std::string formatRealismTable(const std::vector<RealismStats>& cols) {
   row("mean 10-25 m", [](const RealismStats& c) { return c.band_mean[1]; }, 1);
   row("mean 25-50 m", [](const RealismStats& c) { return c.band_mean[2]; }, 1);
   row("mean 50-100 m", [](const RealismStats& c) { return c.band_mean[3]; }, 1);
+  const char* bands[4] = {"2.5-10 m", "10-25 m", "25-50 m", "50-100 m"};
+  for (int k = 0; k < 4; ++k)
+    row(("q90 " + std::string(bands[k])).c_str(), [k](const RealismStats& c) { return c.band_q90[k]; }, 0);
   row("azimuth corr (lag 1)", [](const RealismStats& c) { return c.azimuth_corr; }, 3);
   row("range corr (0.25 m)", [](const RealismStats& c) { return c.range_corr_short; }, 3);
   row("range corr (1 m)", [](const RealismStats& c) { return c.range_corr_long; }, 3);
   row("Cen2018 keypoints/scan", [](const RealismStats& c) { return c.detections_cen; }, 0);
   row("CFAR keypoints/scan", [](const RealismStats& c) { return c.detections_cfar; }, 0);
+  for (int k = 0; k < 4; ++k)
+    row(("Cen2018/scan " + std::string(bands[k])).c_str(), [k](const RealismStats& c) { return c.band_cen[k]; }, 0);
+  row("plain CA-CFAR cells/scan", [](const RealismStats& c) { return c.cacfar; }, 0);
+  for (int k = 0; k < 4; ++k)
+    row(("CA-CFAR/scan " + std::string(bands[k])).c_str(), [k](const RealismStats& c) { return c.band_cacfar[k]; }, 0);
   return os.str();
 }
 

@@ -97,6 +97,10 @@ RenderModel::RenderModel(const SensorConfig& s) : s_(s) {
     double n = std::pow(10.0, (s.noise_floor_db + s.noise_range_slope_db_per_decade * lr) / 10.0);
     double c = std::pow(10.0, (s.noise_floor_db + s.clutter_db + s.clutter_db_per_decade * lr) / 10.0);
     double tot = n + (s.clutter_db > 0 ? c : 0.0);
+    // Near-range leakage (transmitter-receiver coupling, bumper/radome returns).
+    if (s.leakage_db > 0)
+      tot += std::pow(10.0, (s.noise_floor_db + s.leakage_db) / 10.0 -
+                                (b + 0.5) * s.range_resolution / s.leakage_range);
     noise_lin_[b] = float(tot);
     noise_q_[b] = int16_t(std::clamp(std::lround(80.0 * std::log10(tot)), -600l, 1600l));
     thr_lin_[b] = float(tot * std::pow(10.0, s.render_threshold_db / 10.0));
@@ -155,7 +159,10 @@ RenderModel::RenderModel(const SensorConfig& s) : s_(s) {
   for (int q = q_min_; q <= q_max; ++q) {
     double a = std::pow(10.0, q / 8.0 / 20.0);
     double n = std::floor(a);
-    double c = n >= 1 ? std::round(s.power_scale * 20.0 * std::log10(n)) : 0.0;
+    double c = n >= 1 ? s.power_scale * 20.0 * std::log10(n) : 0.0;
+    // Receiver compression: above the knee the output grows by compression_ratio per count.
+    if (c > s.compression_knee) c = s.compression_knee + (c - s.compression_knee) * s.compression_ratio;
+    c = std::round(c);
     lut_[q - q_min_] = uint8_t(std::clamp(c, 0.0, s.saturation));
   }
 }

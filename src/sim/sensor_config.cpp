@@ -1,5 +1,8 @@
 #include "spinradar/sim/sensor_config.hpp"
 
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <type_traits>
@@ -60,6 +63,46 @@ SensorConfig SensorConfig::fromJson(const nlohmann::json& j) {
 
 SensorConfig SensorConfig::load(const std::string& path) {
   return detail::loadJsonFile<SensorConfig>(path);
+}
+
+namespace {
+
+std::vector<std::string> sensorDirs() {
+  std::vector<std::string> dirs;
+  if (const char* e = std::getenv("SPINRADAR_SENSORS_DIR")) dirs.emplace_back(e);
+#ifdef SPINRADAR_SENSORS_DIR
+  dirs.emplace_back(SPINRADAR_SENSORS_DIR);
+#endif
+  return dirs;
+}
+
+}  // namespace
+
+std::vector<std::string> SensorConfig::namedSensors() {
+  namespace fs = std::filesystem;
+  std::vector<std::string> names;
+  for (const auto& d : sensorDirs()) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(d, ec))
+      if (e.path().extension() == ".json") names.push_back(e.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  names.erase(std::unique(names.begin(), names.end()), names.end());
+  return names;
+}
+
+SensorConfig SensorConfig::loadNamed(const std::string& arg) {
+  namespace fs = std::filesystem;
+  if (fs::exists(arg)) return load(arg);
+  if (arg.find('/') == std::string::npos && arg.find('.') == std::string::npos)
+    for (const auto& d : sensorDirs()) {
+      fs::path p = fs::path(d) / (arg + ".json");
+      if (fs::exists(p)) return load(p.string());
+    }
+  std::string known;
+  for (const auto& n : namedSensors()) known += (known.empty() ? "" : ", ") + n;
+  throw std::runtime_error(arg + ": no such sensor file, and not a calibrated sensor name (" +
+                           (known.empty() ? "none found" : known) + ")");
 }
 
 void SensorConfig::save(const std::string& path) const { detail::saveJsonFile(*this, path); }

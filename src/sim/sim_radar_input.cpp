@@ -78,10 +78,10 @@ InputStatus SimRadarInput::readSome(std::vector<uint8_t>& chunk, int64_t& receiv
 
 std::shared_ptr<const Simulator> makeBuiltinSimulator(const std::string& scene,
                                                       const PhysicsConfig& physics, uint64_t seed,
-                                                      double t0) {
+                                                      double t0, const SensorConfig& sensor) {
   Scene s = builtinScene(scene, 0, t0);
-  return std::make_shared<const Simulator>(std::move(s.world), std::move(s.trajectory),
-                                           SensorConfig{}, physics, seed);
+  return std::make_shared<const Simulator>(std::move(s.world), std::move(s.trajectory), sensor,
+                                           physics, seed);
 }
 
 std::unique_ptr<navtech::RadarInput> makeSimInput(std::shared_ptr<const Simulator> sim,

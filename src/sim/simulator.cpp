@@ -153,6 +153,37 @@ void Simulator::Impl::buildScatterers() {
       }
     }
   }
+  addTexturedClutter();
+}
+
+void Simulator::Impl::addTexturedClutter() {
+  // Real scans are full of small returns (kerbs, vegetation, road furniture, ground) standing
+  // out of their neighbourhood; they are fixed in the world, so they are scatterers, placed
+  // over the area the sensor sees along the route (a fixed RNG: same field for every seed).
+  if (sensor.clutter_density <= 0) return;
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (const auto& smp : traj.samples()) {
+    x0 = std::min(x0, smp.pose.x);
+    y0 = std::min(y0, smp.pose.y);
+    x1 = std::max(x1, smp.pose.x);
+    y1 = std::max(y1, smp.pose.y);
+  }
+  const double m = sensor.maxRange();
+  x0 -= m, y0 -= m, x1 += m, y1 += m;
+  const double n_exp = (x1 - x0) * (y1 - y0) * sensor.clutter_density;
+  if (n_exp > 2e7)
+    throw std::invalid_argument("sensor parameter 'clutter_density': " + std::to_string(n_exp) +
+                                " scatterers over this route, more than 2e7");
+  detail::Rng rng(0xC1077E12ull);
+  const size_t n = size_t(n_exp);
+  statics.reserve(statics.size() + n);
+  for (size_t i = 0; i < n; ++i) {
+    Scatterer c;
+    c.x = x0 + (x1 - x0) * rng.uniform();
+    c.y = y0 + (y1 - y0) * rng.uniform();
+    c.rcs_db = float(sensor.clutter_rcs_db + sensor.clutter_rcs_sd_db * rng.normal());
+    statics.push_back(c);
+  }
 }
 
 void Simulator::Impl::buildGrid() {

@@ -78,6 +78,7 @@ struct Simulator::Impl {
 
   Impl(World w, Trajectory t, SensorConfig s, PhysicsConfig p, uint64_t sd);
   void buildScatterers();
+  void addTexturedClutter();
   void buildGrid();
   void render(double t0, uint64_t scan_key, PolarScan& out) const;
 };

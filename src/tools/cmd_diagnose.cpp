@@ -6,6 +6,7 @@
 
 #include "command.hpp"
 #include "spinradar/io/scan_folder.hpp"
+#include "spinradar/diagnose/appearance.hpp"
 #include "spinradar/diagnose/chirp_doppler.hpp"
 #include "spinradar/diagnose/diagnose.hpp"
 #ifdef SPINRADAR_HAVE_BAG
@@ -26,7 +27,40 @@ struct DiagnoseArgs {
   double alpha = 0.001;
   uint64_t seed = 97;
   bool no_resimulate = false;
+  bool appearance = false;
+  std::string sensor;  // base sensor model of the appearance stage (file or calibrated name)
+  int appearance_scans = 4;
 };
+
+/// The appearance stage (no world or trajectory needed): findings, fitted sensor file, plots
+/// into <out>/appearance.
+void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
+                   const sim::PhysicsConfig& physics) {
+  sim::SensorConfig s = a.sensor.empty() ? sim::SensorConfig{} : sim::SensorConfig::loadNamed(a.sensor);
+  // The re-simulation must have the recording's geometry.
+  const PolarScan& p = scans.front();
+  s.azimuths = p.azimuths;
+  s.bins = p.bins;
+  s.range_resolution = p.range_resolution;
+  s.encoder_size = std::max(p.encoder_size, p.azimuths);
+  s.validate();
+  diagnose::AppearanceOptions opt;
+  opt.scans = a.appearance_scans;
+  const auto rep = diagnose::diagnoseAppearance(scans, s, physics, opt);
+  const std::string dir = (fs::path(a.out) / "appearance").string();
+  diagnose::writeAppearanceReport(rep, scans, opt, dir);
+  std::cout << "appearance:";
+  int named = 0;
+  for (const auto& f : rep.findings)
+    if (f.named) {
+      ++named;
+      std::cout << " " << f.effect << " " << f.base << " -> " << f.value << " +- " << f.stddev
+                << " " << f.unit << " (z " << f.z << ");";
+    }
+  if (!named) std::cout << " nothing named";
+  std::cout << "\nappearance: worst per-band realism gap " << 100 * rep.worst_gap_before << " % -> "
+            << 100 * rep.worst_gap_after << " %; report and sensor_fitted.json in " << dir << "\n";
+}
 
 /// The recording as a scan folder: a rosbag of RadarScan messages is first unpacked into
 /// <out>/recording_from_bag (Oxford layout).
@@ -103,6 +137,7 @@ void run(const DiagnoseArgs& a) {
     std::cout << "report in " << a.out << "\n";
   };
   if (!a.base.empty()) in.base = sim::PhysicsConfig::load(a.base);
+  if (a.appearance || (a.trajectory.empty() && !a.timing_only)) runAppearance(a, in.scans, in.base);
   if (a.timing_only || a.trajectory.empty()) {
     timingOnly(a.timing_only ? "--timing-only" : "no --trajectory given");
     return;
@@ -168,5 +203,14 @@ SPINRADAR_COMMAND(
       app.add_option("--seed", a->seed, "Noise seed of the re-simulation");
       app.add_flag("--no-resimulate", a->no_resimulate,
                    "Skip re-rendering with the fitted effects (use the linear model's residuals)");
+      app.add_flag("--appearance", a->appearance,
+                   "Run the appearance stage (levels, widths, texture; fitted sensor file) also "
+                   "with a trajectory; without --trajectory it always runs");
+      app.add_option("--sensor", a->sensor,
+                     "Base sensor model of the appearance stage: JSON file or calibrated name "
+                     "(oxford, mulran, boreas_rt, radiate); default: the CIR204-H defaults");
+      app.add_option("--appearance-scans", a->appearance_scans,
+                     "Re-simulated scans per evaluation in the appearance fit")
+          ->capture_default_str();
       app.callback([a] { run(*a); });
     });

@@ -36,7 +36,7 @@ void runRealism(const RealismCmdOptions& o) {
   } else {
     physics = PhysicsConfig::load(o.physics);
   }
-  SensorConfig sensor = o.sensor.empty() ? SensorConfig{} : SensorConfig::load(o.sensor);
+  SensorConfig sensor = o.sensor.empty() ? SensorConfig{} : SensorConfig::loadNamed(o.sensor);
   for (const auto& name : o.scenes) {
     Scene sc = builtinScene(name);
     Simulator sim(sc.world, sc.trajectory, sensor, physics, o.seed);
@@ -73,7 +73,7 @@ SPINRADAR_COMMAND("realism", "Compare simulated scans with the real samples (his
                         ->capture_default_str();
                     app.add_option("--recording", o->recordings, "Extra recording folders");
                     app.add_option("--physics", o->physics, "Physics JSON (default: distortion, Doppler, movers)");
-                    app.add_option("--sensor", o->sensor, "Sensor parameters JSON");
+                    app.add_option("--sensor", o->sensor, "Sensor: JSON file or calibrated name (oxford, mulran, boreas_rt, radiate)");
                     app.add_option("--scans", o->scans, "Scans per simulated scene")->capture_default_str();
                     app.add_option("--seed", o->seed, "Noise seed")->capture_default_str();
                     app.add_option("--min-range", o->min_range, "m")->capture_default_str();

@@ -34,7 +34,7 @@ struct ServeOptions {
   int port = 6317;
   std::string bind = "127.0.0.1";
   double rate = 1.0;
-  std::string physics;
+  std::string physics, sensor;
   bool loop = false;
   int bit_depth = 8;
   bool sim_clock = false;
@@ -44,7 +44,9 @@ struct ServeOptions {
 
 void serve(const ServeOptions& o) {
   using namespace spinradar;
-  auto sim = sim::makeBuiltinSimulator(o.scene, loadPhysics(o.physics), o.seed);
+  const sim::SensorConfig sensor =
+      o.sensor.empty() ? sim::SensorConfig{} : sim::SensorConfig::loadNamed(o.sensor);
+  auto sim = sim::makeBuiltinSimulator(o.scene, loadPhysics(o.physics), o.seed, 0.0, sensor);
   navtech::ServerOptions so;
   so.bind = o.bind;
   so.port = o.port;
@@ -92,6 +94,9 @@ SPINRADAR_COMMAND("serve", "Serve a simulated scene as a live Navtech radar (TCP
                     app.add_option("--physics", o->physics,
                                    "Physics configuration: a JSON file or an inline JSON object, e.g. "
                                    "'{\"motion_distortion\": true, \"doppler\": 0.049}'");
+                    app.add_option("--sensor", o->sensor,
+                                   "Sensor: a JSON file or a calibrated sensor name (oxford, mulran, "
+                                   "boreas_rt, radiate; config/sensors/)");
                     app.add_flag("--loop", o->loop, "Start the route over at its end (stamps keep increasing)");
                     app.add_option("--bit-depth", o->bit_depth, "FFT data: 8 (type 30) or 16 (type 31)")
                         ->check(CLI::IsMember({8, 16}))

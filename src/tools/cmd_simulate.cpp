@@ -52,7 +52,7 @@ void runSimulate(const SimulateOptions& o) {
     traj = Trajectory::loadCsv(o.trajectory);
   }
   PhysicsConfig physics = o.physics.empty() ? PhysicsConfig{} : PhysicsConfig::load(o.physics);
-  SensorConfig sensor = o.sensor.empty() ? SensorConfig{} : SensorConfig::load(o.sensor);
+  SensorConfig sensor = o.sensor.empty() ? SensorConfig{} : SensorConfig::loadNamed(o.sensor);
   Simulator sim(std::move(world), std::move(traj), sensor, physics, o.seed);
   int total = sim.scanCount();
   std::cerr << "simulate: " << total << " rotations available, physics "
@@ -88,7 +88,7 @@ SPINRADAR_COMMAND("simulate", "Simulate a recording (Oxford polar PNGs + true tr
                     app.add_option("--trajectory", o->trajectory, "Trajectory CSV (t,x,y,yaw)");
                     app.add_option("--physics", o->physics,
                                    "Physics configuration JSON (absent effects are off)");
-                    app.add_option("--sensor", o->sensor, "Sensor parameters JSON (subset)");
+                    app.add_option("--sensor", o->sensor, "Sensor: JSON file (subset) or calibrated name (oxford, mulran, boreas_rt, radiate)");
                     app.add_option("--seed", o->seed, "Noise seed")->capture_default_str();
                     app.add_option("--variant", o->variant, "Built-in scene layout variant")
                         ->capture_default_str();

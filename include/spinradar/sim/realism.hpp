@@ -31,7 +31,25 @@ struct RealismStats {
   double range_corr_long = 0;    ///< correlation at a range lag of 1 m
   double detections_cen = -1;    ///< Cen2018 keypoints per scan (-1 = not run)
   double detections_cfar = -1;   ///< CA-CFAR keypoints per scan (-1 = not run)
+  /// Per range band (kBandEdges): q90 count, plain CA-CFAR cells and Cen2018 keypoints per scan.
+  double band_q90[4] = {0, 0, 0, 0};
+  double band_cacfar[4] = {0, 0, 0, 0};
+  double band_cen[4] = {-1, -1, -1, -1};
+  double cacfar = 0;              ///< plain CA-CFAR cells per scan, all bands
 };
+
+/// Range bands of the per-band figures (m).
+constexpr double kBandEdges[5] = {2.5, 10, 25, 50, 100};
+
+/// A plain cell-averaging CFAR on the linear power of one row (count = dB): cells whose power
+/// exceeds 12 dB over the mean of 16 training bins each side (4 guard bins each side), as an
+/// independent reader of a scan would run it. Counts the flagged cells per band into `per_band`.
+void countPlainCaCfar(const PolarScan& scan, double min_range, double max_range,
+                      double per_band[4]);
+
+/// Relative gap |sim - real| / real of the per-band figures (mean, q90, CA-CFAR, Cen2018),
+/// 16 values; the worst one is what "within 15 %" is checked against.
+std::vector<double> bandGaps(const RealismStats& sim, const RealismStats& real);
 
 RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::string& name,
                             const RealismOptions& options = {});
@@ -41,7 +59,7 @@ RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::stri
 std::vector<std::pair<std::string, std::vector<PolarScan>>> loadRealSamples(
     const std::string& realdata_dir);
 
-/// A Markdown table, one column per data set.
+/// A Markdown table, one column per data set (with the per-band rows).
 std::string formatRealismTable(const std::vector<RealismStats>& columns);
 
 }  // namespace spinradar::sim

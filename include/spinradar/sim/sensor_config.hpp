@@ -1,6 +1,7 @@
 #pragma once
 // Sensor model parameters (Navtech CIR204-H defaults). One definition, like params.hpp.
 #include <string>
+#include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -23,6 +24,13 @@
   X(double, noise_range_slope_db_per_decade, 0.0, -40.0, 40.0, "dB/dec", "Noise floor change per decade of range (from 10 m)") \
   X(double, clutter_db, 2.0, 0.0, 80.0, "dB", "Diffuse ground clutter power at 10 m, above the noise floor") \
   X(double, clutter_db_per_decade, -14.0, -60.0, 0.0, "dB/dec", "Ground clutter change per decade of range") \
+  X(double, clutter_density, 0.0, 0.0, 4.0, "1/m^2", "Textured clutter: world-fixed point scatterers per m^2 around the route (0 = off)") \
+  X(double, clutter_rcs_db, -30.0, -80.0, 20.0, "dBsm", "Median RCS of the textured clutter scatterers") \
+  X(double, clutter_rcs_sd_db, 6.0, 0.0, 20.0, "dB", "Log-normal spread of the textured clutter RCS") \
+  X(double, leakage_db, 0.0, 0.0, 80.0, "dB", "Near-range leakage at 0 m above the noise floor (0 = off)") \
+  X(double, leakage_range, 1.0, 0.05, 50.0, "m", "Range over which the near-range leakage falls by 10 dB") \
+  X(double, compression_knee, 255.0, 1.0, 255.0, "count", "Output count above which the receiver compresses") \
+  X(double, compression_ratio, 1.0, 0.05, 1.0, "", "Output counts per dB above the compression knee (1 = none)") \
   X(double, range_psf_sigma_bins, 2.7, 0.3, 20.0, "bins", "Std of the Gaussian-like range mainlobe in power (real CTS350-X/CIR204: ~2.7)") \
   X(double, range_sidelobe_db, -60.0, -120.0, -10.0, "dB", "FFT-window range sidelobe level (decaying as offset^-3)") \
   X(int, range_psf_half_width, 24, 2, 64, "bins", "Half width of the rendered range point spread") \
@@ -45,6 +53,12 @@ struct SensorConfig {
   nlohmann::json toJson() const;
   static SensorConfig fromJson(const nlohmann::json& j);
   static SensorConfig load(const std::string& path);  ///< errors name file + line + reason
+  /// A sensor file by path, or by the name of a calibrated sensor (config/sensors/<name>.json,
+  /// also searched in $SPINRADAR_SENSORS_DIR): "oxford", "mulran", "boreas_rt", "radiate".
+  /// An unknown name throws, listing the names available.
+  static SensorConfig loadNamed(const std::string& name_or_path);
+  /// Names of the calibrated sensor files found.
+  static std::vector<std::string> namedSensors();
   void save(const std::string& path) const;
   /// Maximum rendered range (m): bins * range_resolution.
   double maxRange() const { return bins * range_resolution; }

@@ -55,7 +55,8 @@ std::unique_ptr<navtech::RadarInput> makeSimInput(std::shared_ptr<const Simulato
 /// scene, listing the valid names.
 std::shared_ptr<const Simulator> makeBuiltinSimulator(const std::string& scene,
                                                       const PhysicsConfig& physics,
-                                                      uint64_t seed = 1, double t0 = 0.0);
+                                                      uint64_t seed = 1, double t0 = 0.0,
+                                                      const SensorConfig& sensor = {});
 
 /// Scans for NavtechServer, in order from `first_scan`. With `loop`, starts over at the end
 /// with stamps shifted by the trajectory's duration so time keeps increasing.

@@ -1,0 +1,117 @@
+#pragma once
+// The appearance stage of the diagnosis: how returns LOOK (levels, widths, texture), not where
+// they are. Works on real scans alone (no world file, no trajectory): the same figures are
+// measured on the recording and on a re-simulation of a reference scene with the base sensor
+// model; their differences are located (range band, intensity level, azimuth, neighbourhood of
+// strong returns), named from a catalogue of sensor physics, and fitted by indirect inference
+// (figure Jacobian from re-simulations with each parameter nudged). Method: docs/diagnose.md.
+#include <array>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "spinradar/core/polar_scan.hpp"
+#include "spinradar/sim/physics.hpp"
+#include "spinradar/sim/realism.hpp"
+#include "spinradar/sim/sensor_config.hpp"
+
+namespace spinradar::diagnose {
+
+constexpr int kBands = 4;  ///< sim::kBandEdges: 2.5-10, 10-25, 25-50, 50-100 m
+
+/// Appearance figures of a set of scans; each is the mean over scans, `*_se` its standard error
+/// from the scan-to-scan scatter.
+struct AppearanceFigures {
+  int scans = 0;
+  std::array<double, kBands> floor{}, floor_se{};    ///< mean of the lower half of counts
+  std::array<double, kBands> mean{}, mean_se{};      ///< mean count
+  std::array<double, kBands> bright{}, bright_se{};  ///< mean of the top 1 % of counts
+  std::array<double, kBands> cfar{}, cfar_se{};      ///< log10(1 + plain CA-CFAR cells/scan)
+  double beam_rows = 0, beam_rows_se = 0;  ///< azimuth equivalent width of isolated peaks, rows
+  double psf_bins = 0, psf_bins_se = 0;    ///< range equivalent width of isolated peaks, bins
+  int peaks = 0;                           ///< isolated peaks measured (all scans)
+  double az_sidelobe_db = 0;   ///< mean level 3-6 rows off strong peaks, dB below the peak
+  double rng_sidelobe_db = 0;  ///< mean level 10-20 bins off strong peaks, dB below the peak
+  double near_excess = 0;      ///< mean count below 2 m minus the 2.5-10 m floor (leakage)
+  double top_count = 0;        ///< largest count present
+  double pileup = 0;           ///< cells at top_count / mean cells at the 3 values below it
+  double behind = 0, behind_se = 0;  ///< share of bright cells >= 2 m behind the first strong hit
+  double row_sd = 0;           ///< std of the per-row floor (noise texture across azimuths), counts
+  int distinct_low_codes = 0;  ///< distinct values among counts 1..30 (log quantisation: ~10)
+  /// Per replicate (scan quarter, in scan order): floor[4], mean[4], bright[4], cfar[4], beam,
+  /// range width (NaN where a quarter has too few isolated peaks). Recordings of the same route
+  /// are compared replicate by replicate (paired), which removes the scene's own variation.
+  std::vector<std::vector<double>> replicates;
+};
+
+AppearanceFigures measureAppearance(const std::vector<PolarScan>& scans);
+
+/// One parameter of the appearance catalogue.
+struct AppearanceFinding {
+  std::string effect;     ///< catalogue name ("beam width", "noise floor", ...)
+  std::string parameter;  ///< sensor/physics key it sets
+  std::string unit;
+  double base = 0, value = 0, stddev = 0;  ///< base model, fitted, 1-sigma of the fit
+  double z = 0;                            ///< |value - base| / stddev
+  double size = 0;             ///< practical size of the change in `size_unit`
+  std::string size_unit;       ///< "dB", "bins", "rows", "x"
+  double gap_before = 0, gap_after = 0;  ///< its figure's gap (real - sim) before/after, in units
+  bool named = false;          ///< significant AND practically large
+  std::string verdict;         ///< "mismatch", "negligible", "not significant", "not identifiable"
+};
+
+/// A located appearance difference: one figure in one place, real vs re-simulated.
+struct AppearanceLocate {
+  std::string by, where;
+  double real = 0, sim = 0;  ///< in `unit`
+  std::string unit;
+  std::string note;
+};
+
+struct AppearanceOptions {
+  std::string scene = "city";  ///< reference scene of the re-simulation
+  int scans = 4;               ///< re-simulated scans per evaluation
+  uint64_t seed = 11;
+  int iterations = 3;          ///< Newton steps of the indirect-inference fit
+  double z_min = 4.0;          ///< significance needed to name an effect
+  /// Practical thresholds: a change smaller than these is negligible (1 dB for levels, 10 %
+  /// for widths, 2 dB/decade for slopes).
+  double level_db_min = 1.0, width_rel_min = 0.10, slope_min = 2.0;
+  double ghost_ratio_min = 1.2;  ///< behind-hit bright share real / sim to name ghosts
+  bool fit_clutter = true;     ///< include the textured clutter in the fit
+  bool realism = true;         ///< realism tables before/after (with detectors)
+};
+
+struct AppearanceReport {
+  std::vector<AppearanceFinding> findings;  ///< named first (largest z), then the rest
+  std::vector<AppearanceLocate> locate;
+  std::vector<std::string> notes;
+  sim::SensorConfig base, fitted;
+  sim::PhysicsConfig base_physics, fitted_physics;
+  AppearanceFigures real, before, after;
+  sim::RealismStats realism_real, realism_before, realism_after;
+  double worst_gap_before = 0, worst_gap_after = 0;  ///< per-band realism gap (relative)
+  double runtime_s = 0;
+  nlohmann::json toJson() const;
+  std::string summaryMarkdown() const;
+};
+
+/// Scans of the reference scene rendered with `sensor` and `physics` (evenly over the route).
+std::vector<PolarScan> renderReference(const sim::SensorConfig& sensor,
+                                       const sim::PhysicsConfig& physics,
+                                       const AppearanceOptions& opt, uint64_t seed);
+
+/// The appearance stage on `real` against the base model `sensor` / `physics` (the geometry
+/// fields of `sensor`, bins, resolution, azimuths, must be the recording's).
+AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real,
+                                    const sim::SensorConfig& sensor,
+                                    const sim::PhysicsConfig& physics,
+                                    const AppearanceOptions& opt = {});
+
+/// Writes appearance.json, appearance.md, sensor_fitted.json, physics_fitted.json and PNG
+/// plots (band profiles before/after, intensity histograms) into out_dir.
+void writeAppearanceReport(const AppearanceReport& rep, const std::vector<PolarScan>& real,
+                           const AppearanceOptions& opt, const std::string& out_dir);
+
+}  // namespace spinradar::diagnose

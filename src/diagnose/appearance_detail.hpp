@@ -1,0 +1,40 @@
+#pragma once
+// Internals of the appearance stage (src/diagnose/appearance_*.cpp).
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "spinradar/diagnose/appearance.hpp"
+
+namespace spinradar::diagnose::detail {
+
+enum class Kind { Level, Slope, Width, Density };
+
+/// A smooth sensor parameter of the appearance catalogue and its finite-difference step.
+struct AppearanceParam {
+  std::string effect, key, unit;
+  double sim::SensorConfig::*field;
+  double step, lo, hi;
+  Kind kind;
+  int block;                 ///< parameters of one block are solved together
+  std::vector<int> figures;  ///< indices into figureVector() this block is fitted to
+};
+
+const std::vector<AppearanceParam>& appearanceParams();
+
+/// floor[4], mean[4], bright[4], cfar[4], beam width, range width.
+constexpr int kFigures = 18;
+Eigen::VectorXd figureVector(const AppearanceFigures& f);
+Eigen::VectorXd figureSe(const AppearanceFigures& f);
+/// Standard error of figures(a) - figures(b): paired by replicate when both hold the same
+/// number of replicates (same route), otherwise from the two standard errors.
+Eigen::VectorXd differenceSe(const AppearanceFigures& a, const AppearanceFigures& b);
+
+/// Fills rep.locate from rep.real / rep.before.
+void locateAppearance(AppearanceReport& rep);
+/// Realism figures of the recording and of the reference re-simulated before/after the fit.
+void realismBeforeAfter(const std::vector<PolarScan>& real, const AppearanceOptions& opt,
+                        AppearanceReport& rep);
+
+}  // namespace spinradar::diagnose::detail
