@@ -214,3 +214,31 @@ TEST(Detector, Cen2018AgreesWithBruteForceReference) {
     EXPECT_GE(matched, 0.99 * ref.size() - 1);
   }
 }
+
+TEST(Detector, Cen2018CandidateBoundLosesNothing) {
+  // Only bins that can reach zq sigma are scored (detector.cpp): the keypoints must be exactly
+  // those of scoring every bin, on speckle with weak and strong targets and several thresholds.
+  std::vector<Target> targets;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> az(0, 2 * M_PI), r(3, 150), snr(3, 40);
+  for (int i = 0; i < 500; ++i) targets.push_back({az(rng), r(rng), snr(rng)});
+  for (unsigned seed : {1u, 2u}) {
+    const PolarScan s = test::syntheticScan(targets, seed, 200, 3000);
+    for (double zq : {0.5, 1.0, 2.0, 2.5, 3.0}) {
+      DetectorConfig c;
+      c.zq = zq;
+      Detector fast(c), every(c);
+      every.setScoreEveryBin(true);
+      std::vector<Keypoint> a, b;
+      fast.detect(s, a);
+      every.detect(s, b);
+      ASSERT_EQ(a.size(), b.size()) << "zq " << zq;
+      ASSERT_GT(a.size(), 100u) << "zq " << zq << ", seed " << seed;
+      for (size_t i = 0; i < a.size(); ++i) {
+        ASSERT_EQ(a[i].azimuth_index, b[i].azimuth_index) << "zq " << zq;
+        ASSERT_EQ(a[i].bin, b[i].bin) << "zq " << zq;
+        ASSERT_EQ(a[i].power, b[i].power) << "zq " << zq;
+      }
+    }
+  }
+}

@@ -35,6 +35,9 @@ class Detector {
   /// of the keypoints (1718 -> 590, MC-RANSAC inliers 132 -> 63) and the yaw error of one of its
   /// two pairs grew 0.007 -> 0.12 deg (mc_doppler). Detector cost +0.1 ms per scan.
   void setAzimuthPeaks(bool on) { config_.azimuth_peaks = on; }
+  /// Cen2018: score every bin instead of only the candidates that can pass (detector.cpp). Same
+  /// keypoints, slower; the switch exists so that tests compare the two.
+  void setScoreEveryBin(bool on) { score_every_bin_ = on; }
   bool azimuthPeaks() const { return config_.azimuth_peaks; }
 
   /// Clears `out` and fills it with the keypoints of `scan` (config.detector selects the method).
@@ -62,6 +65,8 @@ class Detector {
 
   DetectorConfig config_;
   int radius_ = 0;               ///< Gaussian half width in bins
+  double cand_factor_ = 0;       ///< Cen2018 candidates: q > cand_factor_ sigma (detector.cpp)
+  bool score_every_bin_ = false;
   std::vector<int16_t> kernel_;  ///< fixed-point Gaussian taps (sum 2^15), zero-padded to 8k
   std::vector<uint8_t> padded_;  ///< one row with reflected borders
   std::vector<int> cand_;        ///< candidate bins of one row
