@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <spng.h>
 
+#include "support/count_allocations.hpp"
 #include "spinradar/io/png_gray8.hpp"
 #include "spinradar/io/png_io.hpp"
 #include "spinradar/io/scan_io.hpp"
@@ -198,4 +199,29 @@ TEST(PngDecode, WriterRoundTripsThroughOpenCv) {
   }
   EXPECT_THROW(writePng(gray, d.file("no/such/folder/x.png")), std::runtime_error);
   EXPECT_FALSE(fs::exists(d.file("no/such/folder/x.png.tmp")));
+}
+
+TEST(PngDecode, NoAllocationPerScanAfterWarmUp) {
+  // Decoding the next scan of a drive reuses the decoder's and the reader's buffers.
+  sim::Scene scene = sim::builtinScene("city");
+  sim::Simulator simulator(scene.world, scene.trajectory, sim::SensorConfig{}, sim::PhysicsConfig{}, 3);
+  TempDir d;
+  const std::string a = d.file("a.png"), b = d.file("b.png");
+  saveOxfordPng(simulator.renderScan(10), a);
+  saveOxfordPng(simulator.renderScan(11), b);
+  const std::vector<uint8_t> pa = fileBytes(a), pb = fileBytes(b);
+  PngGray8Decoder dec;
+  cv::Mat img;
+  for (int warm = 0; warm < 2; ++warm) {
+    ASSERT_TRUE(dec.decode(pa.data(), pa.size(), img));
+    readPngGray8(a);
+    readPngGray8(b);
+  }
+  long before = g_allocations;
+  ASSERT_TRUE(dec.decode(pb.data(), pb.size(), img));
+  EXPECT_EQ(g_allocations - before, 0) << "PngGray8Decoder::decode";
+  before = g_allocations;
+  const cv::Mat r = readPngGray8(b);
+  EXPECT_EQ(g_allocations - before, 0) << "readPngGray8 (file read + decode)";
+  EXPECT_EQ(r.cols, 3768 + kNavtechMetaColumns);
 }
