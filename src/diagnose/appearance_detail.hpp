@@ -9,7 +9,7 @@
 
 namespace spinradar::diagnose::detail {
 
-enum class Kind { Level, Slope, Width, Density };
+enum class Kind { Level, Slope, Width, Density, Range };
 
 /// A smooth sensor parameter of the appearance catalogue and its finite-difference step.
 struct AppearanceParam {

@@ -26,6 +26,8 @@ const std::vector<AppearanceParam>& appearanceParams() {
        Kind::Level, 0, floor},
       {"noise floor range slope", "noise_range_slope_db_per_decade", "dB/dec",
        &SensorConfig::noise_range_slope_db_per_decade, 4.0, -40, 40, Kind::Slope, 0, floor},
+      {"near-range STC", "stc_range", "m", &SensorConfig::stc_range, 2.0, 0, 100, Kind::Range,
+       0, floor},
       {"receiver gain", "radar_constant_db", "dB", &SensorConfig::radar_constant_db, 3.0, 0, 300,
        Kind::Level, 1, bright},
       {"range gain (STC) slope", "range_gain_db_per_decade", "dB/dec",
@@ -36,7 +38,7 @@ const std::vector<AppearanceParam>& appearanceParams() {
        0.8, 0.3, 20, Kind::Width, 3, {17}},
       {"clutter density", "clutter_density", "1/m^2", &SensorConfig::clutter_density, 0.05, 0, 4,
        Kind::Density, 4, texture},
-      {"clutter level", "clutter_rcs_db", "dBsm", &SensorConfig::clutter_rcs_db, 3.0, -80, 20,
+      {"noise texture", "noise_texture_db", "dB", &SensorConfig::noise_texture_db, 1.5, 0, 15,
        Kind::Level, 4, texture},
   };
   return p;
@@ -172,23 +174,21 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real, const Se
   std::vector<int> active;
   for (int i = 0; i < int(params.size()); ++i) {
     if (!opt.fit_clutter && params[i].block == 4) continue;
+    if (!opt.fit_near_stc && params[i].kind == Kind::Range) continue;
     active.push_back(i);
   }
-  if (opt.fit_clutter && cur.clutter_density <= 0) cur.clutter_density = 0.05;  // start point
-  const bool moved = cur.saturation != sensor.saturation || cur.clutter_density != sensor.clutter_density;
+  if (opt.fit_clutter && cur.clutter_density <= 0) cur.clutter_density = 0.05;  // start points
+  if (opt.fit_near_stc && cur.stc_range <= 0) cur.stc_range = 10.0;
+  if (opt.fit_clutter && cur.noise_texture_db <= 0) cur.noise_texture_db = 1.0;
+  const bool moved = cur.saturation != sensor.saturation ||
+                     cur.clutter_density != sensor.clutter_density ||
+                     cur.stc_range != sensor.stc_range || cur.noise_texture_db != sensor.noise_texture_db;
   AppearanceFigures fig_cur = moved ? figuresOf(cur, phys) : rep.before;
   Eigen::VectorXd e_cur = detail::figureVector(fig_cur);
   const Eigen::VectorXd e_real = detail::figureVector(rep.real);
   const Eigen::VectorXd se = detail::differenceSe(rep.real, fig_cur);
   const int P = int(active.size());
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(detail::kFigures, P);
-  for (int j = 0; j < P; ++j) {
-    const auto& p = params[active[j]];
-    SensorConfig s = cur;
-    s.*(p.field) += p.step;
-    const Eigen::VectorXd d = (detail::figureVector(figuresOf(s, phys)) - e_cur) / p.step;
-    for (int fi : p.figures) J(fi, j) = d[fi];
-  }
   // Blocks: parameters sharing a block number are solved together on their figures.
   std::vector<int> blocks;
   for (int j = 0; j < P; ++j)
@@ -196,6 +196,17 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real, const Se
       blocks.push_back(params[active[j]].block);
   Eigen::VectorXd theta(P), sd = Eigen::VectorXd::Zero(P);
   for (int j = 0; j < P; ++j) theta[j] = cur.*(params[active[j]].field);
+  auto linearise = [&]() {
+    for (int j = 0; j < P; ++j) {
+      const auto& p = params[active[j]];
+      SensorConfig s = cur;
+      s.*(p.field) += p.step;
+      if (s.*(p.field) > p.hi) s.*(p.field) = cur.*(p.field) - p.step;
+      const double h = s.*(p.field) - cur.*(p.field);
+      const Eigen::VectorXd d = (detail::figureVector(figuresOf(s, phys)) - e_cur) / h;
+      for (int fi : p.figures) J(fi, j) = d[fi];
+    }
+  };  linearise();
   auto solveBlocks = [&](const Eigen::VectorXd& resid, bool fill_sd) {
     Eigen::VectorXd step = Eigen::VectorXd::Zero(P);
     for (int bk : blocks) {
@@ -226,15 +237,36 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real, const Se
     }
     return step;
   };
-  double damping = 1.0;
+
+  // Trust region: no parameter moves more than 3 of its steps per iteration; a step that
+  // raises the weighted misfit is halved (twice at most) before it is taken.
+  auto misfit = [&](const Eigen::VectorXd& e) {
+    return ((e_real - e).array() / se.array()).square().sum();
+  };
   for (int it = 0; it < opt.iterations; ++it) {
-    const Eigen::VectorXd step = solveBlocks(e_real - e_cur, false);
+    if (it > 0 && opt.relinearise) linearise();
+    Eigen::VectorXd step = solveBlocks(e_real - e_cur, false);
     for (int j = 0; j < P; ++j) {
-      const auto& p = params[active[j]];
-      theta[j] = std::clamp(theta[j] + damping * step[j], p.lo, p.hi);
-      cur.*(p.field) = theta[j];
+      const double lim = 3 * params[active[j]].step;
+      step[j] = std::clamp(step[j], -lim, lim);
     }
-    fig_cur = figuresOf(cur, phys);
+    const double m0 = misfit(e_cur);
+    SensorConfig trial = cur;
+    AppearanceFigures fig_trial;
+    for (int half = 0; half < 3; ++half) {
+      trial = cur;
+      for (int j = 0; j < P; ++j) {
+        const auto& p = params[active[j]];
+        trial.*(p.field) = std::clamp(theta[j] + step[j], p.lo, p.hi);
+      }
+      fig_trial = figuresOf(trial, phys);
+      if (misfit(detail::figureVector(fig_trial)) < m0 || !opt.relinearise) break;
+      step *= 0.5;
+    }
+    if (opt.relinearise && misfit(detail::figureVector(fig_trial)) >= m0) break;
+    cur = trial;
+    for (int j = 0; j < P; ++j) theta[j] = cur.*(params[active[j]].field);
+    fig_cur = fig_trial;
     e_cur = detail::figureVector(fig_cur);
     if (step.cwiseAbs().maxCoeff() < 1e-3) break;
   }
@@ -258,6 +290,11 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real, const Se
         size = base > 0 ? std::abs(value / base - 1) : 0;
         practical = size >= opt.width_rel_min;
         su = "relative";
+        break;
+      case Kind::Range:
+        size = std::abs(value - base) / sensor.range_resolution;
+        practical = std::abs(value - base) >= 1.0;  // a metre of near-range gain ramp
+        su = "bins";
         break;
       case Kind::Density:
         size = value - base;
@@ -306,10 +343,23 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real, const Se
         if (s <= share[1]) return levels[0] + (s - share[0]) / std::max(share[1] - share[0], 1e-9) * 10;
         return levels[1] + (s - share[1]) / std::max(share[2] - share[1], 1e-9) * 10;
       };
-      f.value = std::clamp(level(rep.real.behind), -80.0, 0.0);
-      f.stddev = std::abs(level(rep.real.behind + rep.real.behind_se) - f.value);
-      phys.extra["multipath"] = f.value;
-      rep.after = figuresOf(cur, phys);
+      if (rep.real.behind > share[2] + 2 * rep.real.behind_se) {
+        // More than the strongest ghosts give: not multipath-like (returns through or past the
+        // first reflector, elevation-beam returns); left to the notes, not switched on.
+        f.named = false;
+        f.verdict = "not ghost-like";
+        f.value = NAN;
+        rep.notes.push_back(
+            "Behind the first strong hit the recording has " + std::to_string(100 * rep.real.behind) +
+            " % bright cells, more than multipath ghosts even at -5 dB give (" +
+            std::to_string(100 * share[2]) + " %): penetration or elevation-beam returns the "
+            "simulator's occlusion removes (occlusion_tolerance), not ghosts.");
+      } else {
+        f.value = std::clamp(level(rep.real.behind), -80.0, 0.0);
+        f.stddev = std::abs(level(rep.real.behind + rep.real.behind_se) - f.value);
+        phys.extra["multipath"] = f.value;
+        rep.after = figuresOf(cur, phys);
+      }
     }
     rep.findings.push_back(f);
   }

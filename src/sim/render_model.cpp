@@ -18,6 +18,12 @@ double hashUniform(uint64_t a, uint64_t b, uint64_t c) {
 
 namespace {
 
+// Near-range sensitivity time control: the receiver gain ramps up to stc_range.
+double nearStc(const SensorConfig& s, double r) {
+  if (s.stc_range <= 0 || r >= s.stc_range) return 1.0;
+  return std::pow(std::max(r, 0.1) / s.stc_range, s.stc_near_db_per_decade / 10.0);
+}
+
 double sinc(double x) { return std::abs(x) < 1e-9 ? 1.0 : std::sin(M_PI * x) / (M_PI * x); }
 
 // Amplitude response of a Hann-windowed FFT, x in resolution cells (first null at |x| = 2).
@@ -96,7 +102,7 @@ RenderModel::RenderModel(const SensorConfig& s) : s_(s) {
     double lr = std::log10(r / 10.0);
     double n = std::pow(10.0, (s.noise_floor_db + s.noise_range_slope_db_per_decade * lr) / 10.0);
     double c = std::pow(10.0, (s.noise_floor_db + s.clutter_db + s.clutter_db_per_decade * lr) / 10.0);
-    double tot = n + (s.clutter_db > 0 ? c : 0.0);
+    double tot = (n + (s.clutter_db > 0 ? c : 0.0)) * nearStc(s, (b + 0.5) * s.range_resolution);
     // Near-range leakage (transmitter-receiver coupling, bumper/radome returns).
     if (s.leakage_db > 0)
       tot += std::pow(10.0, (s.noise_floor_db + s.leakage_db) / 10.0 -
@@ -140,6 +146,27 @@ RenderModel::RenderModel(const SensorConfig& s) : s_(s) {
       mean += pw[i];
     }
     mean /= ns;
+    // Texture: a slow log-normal modulation of the speckle power (range-correlated over
+    // noise_texture_bins), which gives the heavy tails real clutter and noise show; the mean
+    // power is kept.
+    if (s.noise_texture_db > 0) {
+      const int L = std::max(1, int(std::lround(s.noise_texture_bins)));
+      std::vector<double> g(ns), sm(ns);
+      for (int i = 0; i < ns; ++i) g[i] = rng.normal();
+      double acc = 0;
+      for (int k = 0; k < L; ++k) acc += g[k];
+      for (int i = 0; i < ns; ++i) {
+        sm[i] = acc / std::sqrt(double(L));
+        acc += g[(i + L) & (ns - 1)] - g[i];
+      }
+      const double sig = s.noise_texture_db * std::log(10.0) / 10.0;
+      double m2 = 0;
+      for (int i = 0; i < ns; ++i) {
+        pw[i] *= std::exp(sig * sm[i]);
+        m2 += pw[i];
+      }
+      mean = m2 / ns;
+    }
     speckle_lin_.resize(ns);
     speckle_q_.resize(ns);
     for (int i = 0; i < ns; ++i) {
@@ -177,7 +204,7 @@ double RenderModel::beamHalfWidthFor(double ratio) const {
 double RenderModel::pointPower(double rcs_db, double r) const {
   double lr = std::log10(std::max(r, 0.1));
   double db = s_.radar_constant_db + rcs_db - 40.0 * lr + s_.range_gain_db_per_decade * lr;
-  return std::pow(10.0, db / 10.0);
+  return std::pow(10.0, db / 10.0) * nearStc(s_, r);
 }
 
 

@@ -26,6 +26,8 @@ AppearanceOptions quickOptions() {
   o.iterations = 2;
   o.realism = false;
   o.fit_clutter = false;
+  o.fit_near_stc = false;
+  o.relinearise = false;
   return o;
 }
 

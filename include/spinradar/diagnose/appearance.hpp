@@ -73,13 +73,15 @@ struct AppearanceOptions {
   std::string scene = "city";  ///< reference scene of the re-simulation
   int scans = 4;               ///< re-simulated scans per evaluation
   uint64_t seed = 11;
-  int iterations = 3;          ///< Newton steps of the indirect-inference fit
+  int iterations = 4;          ///< Newton steps of the indirect-inference fit
   double z_min = 4.0;          ///< significance needed to name an effect
   /// Practical thresholds: a change smaller than these is negligible (1 dB for levels, 10 %
   /// for widths, 2 dB/decade for slopes).
   double level_db_min = 1.0, width_rel_min = 0.10, slope_min = 2.0;
   double ghost_ratio_min = 1.2;  ///< behind-hit bright share real / sim to name ghosts
   bool fit_clutter = true;     ///< include the textured clutter in the fit
+  bool fit_near_stc = true;    ///< include the near-range STC ramp in the fit
+  bool relinearise = true;     ///< recompute the figure Jacobian at every Newton step
   bool realism = true;         ///< realism tables before/after (with detectors)
 };
 

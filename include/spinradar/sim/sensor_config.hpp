@@ -27,6 +27,10 @@
   X(double, clutter_density, 0.0, 0.0, 4.0, "1/m^2", "Textured clutter: world-fixed point scatterers per m^2 around the route (0 = off)") \
   X(double, clutter_rcs_db, -30.0, -80.0, 20.0, "dBsm", "Median RCS of the textured clutter scatterers") \
   X(double, clutter_rcs_sd_db, 6.0, 0.0, 20.0, "dB", "Log-normal spread of the textured clutter RCS") \
+  X(double, noise_texture_db, 0.0, 0.0, 15.0, "dB", "Std of a slow log-normal texture on the noise (heavy-tailed, K-like clutter; 0 = pure speckle)") \
+  X(double, noise_texture_bins, 8.0, 1.0, 200.0, "bins", "Range correlation length of the noise texture") \
+  X(double, stc_range, 0.0, 0.0, 100.0, "m", "Near-range STC: closer than this every return and the noise are attenuated (0 = off)") \
+  X(double, stc_near_db_per_decade, 30.0, 0.0, 80.0, "dB/dec", "Near-range STC attenuation per decade of range below stc_range") \
   X(double, leakage_db, 0.0, 0.0, 80.0, "dB", "Near-range leakage at 0 m above the noise floor (0 = off)") \
   X(double, leakage_range, 1.0, 0.05, 50.0, "m", "Range over which the near-range leakage falls by 10 dB") \
   X(double, compression_knee, 255.0, 1.0, 255.0, "count", "Output count above which the receiver compresses") \
