@@ -24,6 +24,11 @@ add_test(NAME cli_eval_short_sequence
 set_tests_properties(cli_eval_short_sequence PROPERTIES
   PASS_REGULAR_EXPRESSION "frame-to-frame errors \\(2\\)")
 
+# Every bad input of every class gives a named error and loses nothing (issue 17): one table of
+# rows over all subcommands, inputs built from the simulator (test/tools/bad_inputs.sh).
+add_test(NAME cli_bad_inputs COMMAND bash ${_tt}/bad_inputs.sh ${_cli} ${_out}/bad_inputs)
+set_tests_properties(cli_bad_inputs PROPERTIES TIMEOUT 600)
+
 # Odometry (registered once the subcommand is in the tree).
 if(EXISTS ${PROJECT_SOURCE_DIR}/src/tools/cmd_odometry.cpp)
   add_test(NAME cli_odometry_missing_folder

@@ -78,7 +78,11 @@ bool CaptureReader::next(Record& r) {
   if (!f_) return false;
   const long offset = std::ftell(f_);
   uint8_t head[12];
-  if (std::fread(head, 1, sizeof head, f_) != sizeof head) return false;
+  const size_t got = std::fread(head, 1, sizeof head, f_);
+  if (got != sizeof head) {
+    if (got > 0) truncated_at_ = offset;
+    return false;
+  }
   r.receive_ns = int64_t(getLE(head, 8));
   const uint32_t kind = uint32_t(getLE(head + 8, 4));
   if (kind == kConnect) {
@@ -95,6 +99,7 @@ bool CaptureReader::next(Record& r) {
   r.data.resize(kind);
   if (std::fread(r.data.data(), 1, kind, f_) != kind) {
     r.data.clear();
+    truncated_at_ = offset;
     return false;  // interrupted recording: end of replay
   }
   r.kind = Kind::Data;

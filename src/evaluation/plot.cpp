@@ -388,14 +388,19 @@ cv::Mat tile(const std::vector<cv::Mat>& panels, int cols) {
   return out;
 }
 
-void saveImage(const cv::Mat& image, const std::string& path) {
-  // PNG only, through io's libspng writer: OpenCV's imgcodecs would cost every process 0.3 s
-  // of start-up (see io/png_io.hpp).
+void checkImagePath(const std::string& path) {
   const auto dot = path.rfind('.');
   std::string ext = dot == std::string::npos ? "" : path.substr(dot);
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  if (ext != ".png") throw std::runtime_error(path + ": cannot write image (only .png plots are written)");
-  writePng(image, path, 3);  // errors name the file
+  if (ext != ".png")
+    throw std::runtime_error(path + ": not an image file name (plots are written as .png)");
+}
+
+void saveImage(const cv::Mat& image, const std::string& path) {
+  // PNG only, through io's libspng writer: OpenCV's imgcodecs would cost every process 0.3 s
+  // of start-up (see io/png_io.hpp).
+  checkImagePath(path);
+  writePng(image, path, 3);  // temp file renamed when complete; errors name the file
 }
 
 }  // namespace spinradar::plot

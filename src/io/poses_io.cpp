@@ -8,6 +8,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "spinradar/core/safe_output.hpp"
+
 namespace spinradar {
 
 Eigen::Matrix3d poseMatrix(double x, double y, double yaw) {
@@ -135,6 +137,8 @@ PoseFile readPoseCsv(std::istream& in, const std::string& name) {
     file.poses.push_back(p);
   }
   if (!have_header) throw std::runtime_error(name + ": empty file (expected a t,x,y,yaw header)");
+  if (file.poses.empty())
+    throw std::runtime_error(name + ": a header but no poses (the file holds no data rows)");
   return file;
 }
 
@@ -151,11 +155,9 @@ void writePoseCsv(std::ostream& out, const std::vector<PoseRecord>& poses, bool 
 
 void writePoseCsv(const std::string& path, const std::vector<PoseRecord>& poses,
                   bool with_velocity) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot open for writing");
-  writePoseCsv(out, poses, with_velocity);
-  out.flush();
-  if (!out) throw std::runtime_error(path + ": write failed");
+  AtomicOutputFile file(path);
+  writePoseCsv(file.stream(), poses, with_velocity);
+  file.commit();
 }
 
 void writeTumRow(std::ostream& out, const PoseRecord& p) {
@@ -167,31 +169,40 @@ void writeTumRow(std::ostream& out, const PoseRecord& p) {
 
 struct PoseCsvWriter::Impl {
   std::string path;
-  std::ofstream out;
+  std::unique_ptr<AtomicOutputFile> file;  ///< batch runs
+  std::ofstream live;                      ///< live nodes
   bool with_velocity = true;
+  std::ostream& out() { return file ? static_cast<std::ostream&>(file->stream()) : live; }
 };
 
-PoseCsvWriter::PoseCsvWriter(const std::string& path, bool with_velocity)
+PoseCsvWriter::PoseCsvWriter(const std::string& path, bool with_velocity, bool live)
     : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
   impl_->with_velocity = with_velocity;
-  impl_->out.open(path);
-  if (!impl_->out) throw std::runtime_error(path + ": cannot open for writing");
-  writeHeader(impl_->out, with_velocity);
+  if (live) {
+    impl_->live.open(path);
+    if (!impl_->live) throw std::runtime_error(path + ": cannot open for writing");
+  } else {
+    impl_->file = std::make_unique<AtomicOutputFile>(path);
+  }
+  writeHeader(impl_->out(), with_velocity);
 }
 
 PoseCsvWriter::~PoseCsvWriter() = default;
 
 void PoseCsvWriter::write(const PoseRecord& p) {
-  writeRow(impl_->out, p, impl_->with_velocity);
-  impl_->out.flush();  // a few hundred bytes per scan: keep the file usable if the run stops
-  if (!impl_->out) throw std::runtime_error(impl_->path + ": write failed");
+  std::ostream& out = impl_->out();
+  writeRow(out, p, impl_->with_velocity);
+  if (!impl_->file) out.flush();  // live: the file stays usable if the node is killed
+  if (!out) throw std::runtime_error(impl_->path + ": write failed");
 }
 
 void PoseCsvWriter::close() {
-  if (impl_->out.is_open()) {
-    impl_->out.close();
-    if (impl_->out.fail()) throw std::runtime_error(impl_->path + ": write failed");
+  if (impl_->file) {
+    impl_->file->commit();
+  } else if (impl_->live.is_open()) {
+    impl_->live.close();
+    if (impl_->live.fail()) throw std::runtime_error(impl_->path + ": write failed");
   }
 }
 

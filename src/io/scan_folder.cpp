@@ -8,6 +8,7 @@
 
 #include "scan_io_detail.hpp"
 #include "spinradar/io/png_io.hpp"
+#include "spinradar/core/checked_int.hpp"
 #include "spinradar/io/scan_io.hpp"
 
 namespace fs = std::filesystem;
@@ -27,39 +28,76 @@ bool pngSize(const std::string& path, int& width, int& height) {
   return true;
 }
 
+/// Decodes a PNG only when its size is plausible for a scan (a 200000 x 400 image is not).
+cv::Mat readSmallGray(const std::string& path, int width, int height) {
+  if (width > detail::kMaxBins + kNavtechMetaColumns || height > detail::kMaxBins) return {};
+  try {
+    return readPngGray8(path).clone();  // its buffer is per thread: keep a copy
+  } catch (const std::exception&) {
+    return {};
+  }
+}
+
 /// First row's embedded microsecond stamp of a Navtech-layout PNG (columns 0-7, int64 LE), for
 /// files whose name is not a stamp (e.g. Boreas-RT's test_frame.png).
 bool embeddedStampNs(const std::string& path, int64_t& ns) {
-  cv::Mat img;
-  try {
-    img = readPngGray8(path);
-  } catch (const std::runtime_error&) {
-    return false;
-  }
+  int w = 0, h = 0;
+  if (!pngSize(path, w, h)) return false;
+  const cv::Mat img = readSmallGray(path, w, h);
   if (img.empty() || img.cols < 8) return false;
-  int64_t us = 0;
+  uint64_t us = 0;
   for (int k = 7; k >= 0; --k) us = (us << 8) | img.at<uint8_t>(0, k);
-  ns = us * 1000;
+  ns = mulChecked(static_cast<int64_t>(us), 1000, path + ": row 0: stamp (us)");
   return true;
 }
 
-/// "1574859771.744660272" -> ns, exactly (no double rounding).
-bool parseSecondsNs(const std::string& s, int64_t& ns) {
-  const auto dot = s.find('.');
-  try {
-    const long long sec = std::stoll(s.substr(0, dot));
-    long long frac = 0;
-    if (dot != std::string::npos) {
-      std::string f = s.substr(dot + 1, 9);
-      if (!f.empty() && !std::all_of(f.begin(), f.end(), ::isdigit)) return false;
-      f.resize(9, '0');
-      frac = std::stoll(f);
-    }
-    ns = sec * 1000000000LL + frac;
-    return true;
-  } catch (const std::exception&) {
+/// Does the PNG carry the Oxford/Boreas row metadata (a stamp and an encoder per row)? When not,
+/// `why` says what was seen, for the error that asks for --format.
+bool looksLikeNavtechRows(const std::string& path, std::string& why) {
+  int w = 0, h = 0;
+  if (!pngSize(path, w, h)) {
+    why = path + " is not a PNG";
     return false;
   }
+  const std::string size = path + " is " + std::to_string(w) + " x " + std::to_string(h) +
+                           " (columns x rows)";
+  if (w <= kNavtechMetaColumns) {
+    why = size + ": too narrow for the 11 metadata columns of Oxford/Boreas rows";
+    return false;
+  }
+  const cv::Mat img = readSmallGray(path, w, h);
+  if (img.empty()) {
+    why = size + ": not an 8-bit grey image of a plausible scan size";
+    return false;
+  }
+  int64_t prev_us = 0;
+  int backwards = 0, encoders_changed = 0, prev_enc = -1;
+  for (int r = 0; r < img.rows; ++r) {
+    const uint8_t* p = img.ptr<uint8_t>(r);
+    uint64_t us = 0;
+    for (int k = 7; k >= 0; --k) us = (us << 8) | p[k];
+    const int enc = p[8] | (p[9] << 8);
+    if (us == 0 && enc == 0) continue;  // a missing row
+    if (enc >= 5600) {
+      why = size + ": row " + std::to_string(r) + " columns 8-9 hold " + std::to_string(enc) +
+            ", not an encoder reading (< 5600) of Oxford/Boreas rows";
+      return false;
+    }
+    if (static_cast<int64_t>(us) < prev_us) ++backwards;
+    if (prev_enc >= 0 && enc != prev_enc) ++encoders_changed;
+    prev_us = static_cast<int64_t>(us);
+    prev_enc = enc;
+  }
+  if (encoders_changed == 0) {
+    why = size + ": the encoder (columns 8-9) never changes from row to row";
+    return false;
+  }
+  if (backwards > img.rows / 10) {
+    why = size + ": the stamps (columns 0-7) go backwards on " + std::to_string(backwards) +
+          " rows";
+    return false;
+  }
+  return true;
 }
 
 /// RADIATE Navtech_Polar.txt: "Frame: 000001 Time: 1574859771.744660272" per line.
@@ -74,11 +112,17 @@ std::vector<std::pair<long long, int64_t>> readRadiateTimes(const std::string& t
     std::istringstream ls(line);
     std::string k1, frame, k2, time;
     int64_t ns = 0;
-    if (!(ls >> k1 >> frame >> k2 >> time) || k1 != "Frame:" || k2 != "Time:" ||
-        !std::all_of(frame.begin(), frame.end(), ::isdigit) || frame.empty() || !parseSecondsNs(time, ns))
+    int64_t number = 0;
+    if (!(ls >> k1 >> frame >> k2 >> time) || k1 != "Frame:" || k2 != "Time:")
       throw std::runtime_error(txt + ": line " + std::to_string(lineno) +
                                ": expected 'Frame: <n> Time: <seconds>'");
-    out.emplace_back(std::stoll(frame), ns);
+    if (!parseInt64(frame, number) || number < 0)
+      throw std::runtime_error(txt + ": line " + std::to_string(lineno) + ": frame '" + frame +
+                               "' is not a frame number (digits, at most 9223372036854775807)");
+    if (!parseSecondsToNs(time, ns))
+      throw std::runtime_error(txt + ": line " + std::to_string(lineno) + ": time '" + time +
+                               "' is not seconds within the 64-bit nanosecond range");
+    out.emplace_back(number, ns);
   }
   return out;
 }
@@ -123,34 +167,46 @@ ScanFolder::ScanFolder(const std::string& folder, ScanFormat format, ScanFolderO
   dir_ = dir.string();
 
   std::vector<std::string> pngs, csvs;
+  size_t dangling = 0;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
+    std::error_code lec;
+    if (e.is_symlink(lec) && !fs::exists(e.path(), lec)) {
+      // A link to a missing file: say so (and count) rather than silently read fewer scans.
+      if (++dangling <= 5) scanWarning(e.path().string() + ": dangling link skipped");
+      continue;
+    }
     if (!e.is_regular_file()) continue;
     const std::string ext = e.path().extension().string();
     if (ext == ".png") pngs.push_back(e.path().string());
     else if (ext == ".csv") csvs.push_back(e.path().string());
   }
   if (ec) throw std::runtime_error(folder + ": cannot list folder (" + ec.message() + ")");
+  if (dangling > 5) scanWarning(folder + ": " + std::to_string(dangling) + " dangling links skipped in all");
 
   if (format_ == ScanFormat::Auto) {
-    if (pngs.empty() && !csvs.empty()) {
+    // Guess only when the evidence is unambiguous; otherwise name what was seen.
+    const std::string ask = "; give --format oxford, boreas, mulran or radiate";
+    std::sort(pngs.begin(), pngs.end());
+    std::sort(csvs.begin(), csvs.end());
+    if (!pngs.empty() && !csvs.empty())
+      throw std::runtime_error(folder + ": cannot tell the scan format: it holds both .png (" +
+                               fs::path(pngs.front()).filename().string() + ", ...) and .csv (" +
+                               fs::path(csvs.front()).filename().string() + ", ...) files" + ask);
+    if (!csvs.empty()) {
       format_ = ScanFormat::MulRan;
     } else if (!pngs.empty()) {
-      std::sort(pngs.begin(), pngs.end());
+      std::string why;
       int w = 0, h = 0;
-      if (!pngSize(pngs.front(), w, h))
-        throw std::runtime_error(folder + ": cannot guess the format, " + pngs.front() + " is not a PNG");
-      const int bins = w - kNavtechMetaColumns;
-      if (!radiate_txt.empty())
-        format_ = ScanFormat::Radiate;
-      else if (bins == 3360 || bins == 6848)
-        format_ = ScanFormat::Boreas;
-      else if (w > kNavtechMetaColumns && h < w)
-        format_ = ScanFormat::Oxford;  // rows = azimuths, many more bins than azimuths
-      else if (h > w)
-        format_ = ScanFormat::Radiate;  // transposed: bins down, azimuths across
-      else
-        throw std::runtime_error(folder + ": cannot guess the format of " + pngs.front() + " (" +
-                                 std::to_string(w) + " x " + std::to_string(h) + ")");
+      if (!radiate_txt.empty() && fs::exists(radiate_txt, ec)) {
+        format_ = ScanFormat::Radiate;  // the dataset's own layout: Navtech_Polar + its times
+      } else if (looksLikeNavtechRows(pngs.front(), why)) {
+        pngSize(pngs.front(), w, h);
+        const int bins = w - kNavtechMetaColumns;
+        format_ = bins == 3360 || bins == 6848 ? ScanFormat::Boreas : ScanFormat::Oxford;
+      } else {
+        throw std::runtime_error(folder + ": cannot tell the scan format: " + why +
+                                 ", and there is no Navtech_Polar.txt (RADIATE)" + ask);
+      }
     } else {
       throw std::runtime_error(folder + ": no scan files (.png or .csv) found");
     }
@@ -180,12 +236,15 @@ ScanFolder::ScanFolder(const std::string& folder, ScanFormat format, ScanFolderO
     int64_t ns = 0;
     switch (format_) {
       case ScanFormat::Oxford:
-      case ScanFormat::Boreas: ns = num * 1000; break;  // microseconds
+      case ScanFormat::Boreas:  // microseconds
+        ns = mulChecked(num, 1000, p + ": stamp in the file name (us)");
+        break;
       case ScanFormat::MulRan: ns = num; break;
       case ScanFormat::Radiate: {
         if (radiate_times.empty()) {
           // No Navtech_Polar.txt: synthesise scan times at the rotation rate from the frame index.
-          ns = static_cast<int64_t>((num - 1) * (1e9 / options_.rotation_hz));
+          ns = roundToInt64Checked((double(num) - 1.0) * (1e9 / options_.rotation_hz),
+                                   p + ": frame number x rotation period (ns)");
         } else {
           auto it = std::find_if(radiate_times.begin(), radiate_times.end(),
                                  [&](const auto& t) { return t.first == num; });

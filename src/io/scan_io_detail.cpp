@@ -3,25 +3,39 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
+#include "spinradar/core/checked_int.hpp"
 #include "spinradar/io/scan_io.hpp"
 
 namespace spinradar::detail {
 
 void markMissingAndDuplicates(PolarScan& scan, const std::string& name) {
   const int n = scan.azimuths;
-  int prev = -1, backwards = 0, first_back = -1;
+  int prev = -1, backwards = 0, first_back = -1, empty = 0, repeated = 0;
   for (int a = 0; a < n; ++a) {
-    if (scan.stamp_ns[a] == 0 && scan.encoder[a] == 0) scan.valid[a] = 0;  // zero-filled row
+    if (scan.stamp_ns[a] == 0 && scan.encoder[a] == 0) {
+      scan.valid[a] = 0;  // zero-filled row
+      ++empty;
+    }
     if (!scan.valid[a]) continue;
     if (prev >= 0 && scan.encoder[a] == scan.encoder[prev]) {
       scan.valid[a] = 0;  // the sensor repeated a packet
+      ++repeated;
       continue;
     }
     if (prev >= 0 && scan.stamp_ns[a] < scan.stamp_ns[prev]) {
       if (backwards++ == 0) first_back = a;
     }
     prev = a;
+  }
+  const int valid = static_cast<int>(std::count(scan.valid.begin(), scan.valid.end(), 1));
+  if (valid < n / 2) {  // not a rotation any estimator can use: say why
+    std::ostringstream s;
+    s << name << ": only " << valid << " of " << n << " rows are valid (" << repeated
+      << " repeat the encoder of the row before, " << empty
+      << " are all zero): a constant encoder or a zero-filled scan";
+    throw std::runtime_error(s.str());
   }
   if (backwards > 0) {
     std::ostringstream s;
@@ -58,11 +72,30 @@ bool stemNumber(const std::string& path, long long& value) {
   std::string stem = slash == std::string::npos ? path : path.substr(slash + 1);
   const auto dot = stem.find('.');
   if (dot != std::string::npos) stem = stem.substr(0, dot);
-  if (stem.empty() || stem.size() > 19) return false;
+  if (stem.empty()) return false;
   for (char c : stem)
     if (c < '0' || c > '9') return false;
-  value = std::stoll(stem);
+  int64_t v = 0;
+  if (!parseInt64(stem, v))
+    throw std::runtime_error(path + ": the number in the file name (" + std::to_string(stem.size()) +
+                             " digits) does not fit in 64 bits (largest 9223372036854775807)");
+  value = v;
   return true;
+}
+
+void checkScanShape(int azimuths, int bins, const std::string& name, const char* format,
+                    const char* azimuth_what, const char* bin_what) {
+  std::ostringstream s;
+  if (azimuths < kMinAzimuths || azimuths > kMaxAzimuths)
+    s << name << ": " << azimuths << " azimuths (" << azimuth_what << ") but a " << format
+      << " scan has " << kMinAzimuths << " to " << kMaxAzimuths
+      << " (one per beam of a rotation, 400 for Navtech); a file cut short or of another layout?";
+  else if (bins < kMinBins || bins > kMaxBins)
+    s << name << ": " << bins << " range bins (" << bin_what << ") but a " << format << " scan has "
+      << kMinBins << " to " << kMaxBins << "; a file cut short or of another layout?";
+  else
+    return;
+  throw std::runtime_error(s.str());
 }
 
 }  // namespace spinradar::detail

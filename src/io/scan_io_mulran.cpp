@@ -79,6 +79,8 @@ PolarScan loadMulranCsv(const std::string& path, double range_resolution, double
   if (bins < 0) throw std::runtime_error(path + ": no data lines");
   scan.azimuths = static_cast<int>(scan.stamp_ns.size());
   scan.bins = bins;
+  detail::checkScanShape(scan.azimuths, scan.bins, path, "MulRan", "lines", "values after the 4 "
+                         "leading fields of a line");
   detail::markMissingAndDuplicates(scan, path);
   return scan;
 }

@@ -1,5 +1,6 @@
 // Oxford Radar RobotCar and Boreas polar PNGs (the "Navtech rows" layout).
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <cstring>
 #include <iostream>
@@ -73,6 +74,11 @@ PolarScan decodeRows(const cv::Mat& img, const std::string& name, double resolut
     if (enc >= scan.encoder_size) {
       std::ostringstream s;
       s << name << ": row " << a << ": encoder " << enc << " >= " << scan.encoder_size;
+      throw std::runtime_error(s.str());
+    }
+    if (us > INT64_MAX / 1000 || us < INT64_MIN / 1000) {  // ns would overflow int64
+      std::ostringstream s;
+      s << name << ": row " << a << ": stamp " << us << " us is out of range (more than 292 years)";
       throw std::runtime_error(s.str());
     }
     scan.stamp_ns[a] = us * 1000;
@@ -157,8 +163,17 @@ PolarScan decodeOxfordImage(const cv::Mat& image, const std::string& name,
 
 void encodeOxfordImage(const PolarScan& scan, cv::Mat& image) { encodeRows(scan, image, false); }
 
+/// Rows = azimuths, columns = 11 metadata + bins: checked before decoding.
+void checkRowsShape(const cv::Mat& img, const std::string& path, const char* format) {
+  if (img.cols > kNavtechMetaColumns)
+    detail::checkScanShape(img.rows, img.cols - kNavtechMetaColumns, path, format, "rows",
+                           "columns after the 11 metadata columns");
+}
+
 PolarScan loadOxfordPng(const std::string& path, double range_resolution, double range_offset) {
-  return decodeRows(readGray(path), path, range_resolution, range_offset, Column10::Valid);
+  const cv::Mat img = readGray(path);
+  checkRowsShape(img, path, "Oxford");
+  return decodeRows(img, path, range_resolution, range_offset, Column10::Valid);
 }
 
 void saveOxfordPng(const PolarScan& scan, const std::string& path) {
@@ -173,6 +188,7 @@ void saveOxfordPng(const PolarScan& scan, const std::string& path) {
 
 PolarScan loadBoreasPng(const std::string& path, double range_offset) {
   const cv::Mat img = readGray(path);
+  checkRowsShape(img, path, "Boreas");
   const int bins = img.cols - kNavtechMetaColumns;
   double res = 0.0;
   if (bins == 3360)

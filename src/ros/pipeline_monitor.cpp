@@ -45,7 +45,7 @@ class PipelineMonitor : public nodelet::Nodelet {
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     const std::string csv = pnh.param<std::string>("odom_csv", "");
     summary_path_ = pnh.param<std::string>("summary", "");
-    if (!csv.empty()) writer_ = std::make_unique<spinradar::PoseCsvWriter>(csv, true);
+    if (!csv.empty()) writer_ = std::make_unique<spinradar::PoseCsvWriter>(csv, true, true);
     // Only the arrival time of each scan is used; subscribing with the publisher's own type
     // keeps the in-manager hand-over zero-copy.
     if (pnh.param<std::string>("input", "polar_scan") == "oxford_image")

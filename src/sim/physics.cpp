@@ -35,7 +35,8 @@ bool isOn(const nlohmann::json& v) {
   return true;  // objects/strings configure an effect that is on
 }
 
-// Checks the simulator's own extra effects; unknown keys pass through untouched.
+// Checks the simulator's own extra effects; an unknown key (a misspelt "dopler") is an error,
+// as in the sensor JSON, rather than an effect silently left out.
 void checkExtra(const std::string& key, const nlohmann::json& v) {
   const char* k = key.c_str();
   if (key == "stamp_bursts") {
@@ -64,6 +65,12 @@ void checkExtra(const std::string& key, const nlohmann::json& v) {
   } else if (key == "scan_pose_time") {
     if (!v.is_string() || (v != "mid" && v != "start"))
       throw JsonPathError({{k, -1}}, "must be \"mid\" or \"start\"");
+  } else {
+    throw JsonPathError({{k, -1}},
+                        "unknown effect (expected motion_distortion, doppler, timestamp_offset, "
+                        "azimuth_offset, range_offset, moving_objects, stamp_bursts, "
+                        "rotation_jitter, multipath, attenuation, encoder_wobble, "
+                        "chirp_alternate, scan_pose_time)");
   }
 }
 

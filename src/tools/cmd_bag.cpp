@@ -3,7 +3,9 @@
 #include <filesystem>
 #include <memory>
 
+#include "cli_checks.hpp"
 #include "command.hpp"
+#include "output_guard.hpp"
 #include "progress.hpp"
 #include "scan_bag.hpp"
 
@@ -14,6 +16,7 @@ using namespace spinradar;
 struct BagArgs {
   std::string input, out, topic, frame_id = "radar", format = "auto";
   double range_resolution = 0.0, rotation_hz = 4.0;
+  bool force = false;
 };
 
 void run(const BagArgs& a) {
@@ -29,16 +32,23 @@ void run(const BagArgs& a) {
     ScanFolderOptions opts;
     if (a.range_resolution > 0) opts.range_resolution = a.range_resolution;
     const ScanFolder folder(a.input, parseScanFormat(a.format), opts);
+    cli::refuseOutputsOverInputs({{a.out, "--out"}}, cli::scanFolderInputs(folder, "--input"));
     bag::ScanBagOptions o;
     if (!a.topic.empty()) o.topic = a.topic;
     o.frame_id = a.frame_id;
     o.rotation_hz = a.rotation_hz;
-    const size_t n = bag::folderToBag(folder, a.out, o, report);
+    AtomicOutputFile file(a.out);  // renamed onto --out when complete
+    const size_t n = bag::folderToBag(folder, file.tempPath(), o, report);
+    file.commit();
     std::fprintf(stderr, "wrote %zu %s scans from %s to %s on %s\n", n,
                  scanFormatName(folder.format()), folder.folder().c_str(), a.out.c_str(),
                  o.topic.c_str());
   } else {
-    const size_t n = bag::bagToFolder(a.input, a.out, a.topic, report);
+    refuseOutputOverInput({a.out, "--out"}, {{a.input, "--input"}}, true);
+    AtomicOutputFolder folder(a.out, a.force);  // moved into place when complete
+    const size_t n = bag::bagToFolder(a.input, folder.tempPath(), a.topic, report);
+    if (n == 0) throw std::runtime_error(a.input + ": no RadarScan messages; nothing written");
+    folder.commit();
     std::fprintf(stderr, "wrote %zu scans to %s/radar (Oxford layout)\n", n, a.out.c_str());
   }
 #else
@@ -67,9 +77,12 @@ SPINRADAR_COMMAND("bag", "Convert a scan folder to a rosbag of RadarScan message
                         ->check(CLI::IsMember({"auto", "oxford", "boreas", "mulran", "radiate"}));
                     app.add_option("--range-resolution", a->range_resolution,
                                    "Metres per bin of an input folder (default: the format's)")
-                        ->check(CLI::PositiveNumber);
+                        ->check(cli::positive());
                     app.add_option("--rotation-hz", a->rotation_hz,
                                    "Rotation rate written into the messages")
-                        ->check(CLI::PositiveNumber);
+                        ->check(cli::positive());
+                    app.add_flag("--force", a->force,
+                                 "Bag to folder: write into a non-empty --out folder (its old "
+                                 "scans are removed first)");
                     app.callback([a] { run(*a); });
                   });

@@ -17,6 +17,7 @@
 #include <opencv2/core.hpp>
 #include <tbb/global_control.h>
 
+#include "cli_checks.hpp"
 #include "command.hpp"
 #include "pipeline_options.hpp"
 #include "spinradar/features/feature_extractor.hpp"
@@ -295,14 +296,16 @@ SPINRADAR_COMMAND(
       app.add_option("--input,-i", a->input, "Folder of scans (default: simulate a pair)");
       app.add_option("--format", a->format, "Scan layout of --input (default: guessed)")
           ->check(CLI::IsMember({"auto", "oxford", "boreas", "mulran", "radiate"}));
-      app.add_option("--first", a->first, "Index of the pair's first scan in --input");
+      app.add_option("--first", a->first, "Index of the pair's first scan in --input")
+          ->check(cli::atLeast(0));
       app.add_option("--scene", a->scene, "Built-in scene to simulate (default city)");
-      app.add_option("--sim-time", a->sim_time, "Simulated pair starts this far into the route, s");
-      app.add_option("--runs", a->runs, "Timed repetitions")->check(CLI::PositiveNumber);
+      app.add_option("--sim-time", a->sim_time, "Simulated pair starts this far into the route, s")
+          ->check(cli::atLeast(0));
+      app.add_option("--runs", a->runs, "Timed repetitions")->check(cli::atLeast(1));
       app.add_option("--warmup", a->warmup, "Untimed repetitions first")
-          ->check(CLI::NonNegativeNumber);
+          ->check(cli::atLeast(0));
       app.add_option("--threads", a->threads, "TBB thread limit (default 1: one core; 0 = all)")
-          ->check(CLI::NonNegativeNumber);
+          ->check(cli::atLeast(0));
       a->pipeline.add(app);
       app.callback([a] { run(*a); });
     });

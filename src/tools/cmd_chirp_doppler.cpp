@@ -10,7 +10,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_checks.hpp"
 #include "command.hpp"
+#include "spinradar/core/safe_output.hpp"
 #include "spinradar/io/scan_folder.hpp"
 #include "spinradar/io/scan_io.hpp"
 #include "spinradar/diagnose/chirp_doppler.hpp"
@@ -62,6 +64,10 @@ void runChirpDoppler(ChirpDopplerArgs& a) {
   if (a.beta > 0) a.opt.beta = a.beta;
   if (a.speed > 0) a.opt.speed = a.speed;
   if (!fs::exists(a.input)) throw std::runtime_error(a.input + ": no such file or folder");
+  if (!(a.opt.min_range < a.opt.max_range))
+    throw std::invalid_argument("--min-range " + readableNumber(a.opt.min_range) +
+                                " m is not below --max-range " + readableNumber(a.opt.max_range) + " m");
+  refuseOutputOverInput({a.json, "--json"}, {{a.input, "--input"}}, false);
 
   std::vector<std::pair<std::string, PolarScan>> scans;
   if (fs::is_directory(a.input)) {
@@ -118,10 +124,9 @@ void runChirpDoppler(ChirpDopplerArgs& a) {
     if (a.json == "-") {
       std::cout << out.dump(2) << "\n";
     } else {
-      std::ofstream f(a.json);
-      if (!f) throw std::runtime_error(a.json + ": cannot write");
-      f << out.dump(2) << "\n";
-      if (!f) throw std::runtime_error(a.json + ": write failed");
+      AtomicOutputFile f(a.json);
+      f.stream() << out.dump(2) << "\n";
+      f.commit();
     }
   }
 }
@@ -139,14 +144,25 @@ SPINRADAR_COMMAND(
       app.add_option("--speed", a->speed, "Known speed in m/s: gives beta");
       app.add_option("--json", a->json, "Write the result as JSON to this file ('-' = stdout)");
       app.add_option("--format", a->format, "auto, oxford, boreas, mulran, radiate")->capture_default_str();
-      app.add_option("--range-resolution", a->range_resolution, "m per bin (default: the format's own)");
+      app.add_option("--range-resolution", a->range_resolution, "m per bin (default: the format's own)")
+          ->check(cli::positive());
       app.add_option("--range-offset", a->range_offset, "m added to every range (default: the format's own)");
-      app.add_option("--first", a->first, "Folder: first scan index")->capture_default_str();
-      app.add_option("--max-scans", a->max_scans, "Folder: scans to analyse")->capture_default_str();
-      app.add_option("--min-range", a->opt.min_range, "m: closer bins (leakage) are ignored")->capture_default_str();
-      app.add_option("--max-range", a->opt.max_range, "m: farther bins are ignored");
+      app.add_option("--first", a->first, "Folder: first scan index")
+          ->capture_default_str()
+          ->check(cli::atLeast(0));
+      app.add_option("--max-scans", a->max_scans, "Folder: scans to analyse")
+          ->capture_default_str()
+          ->check(cli::atLeast(1));
+      app.add_option("--min-range", a->opt.min_range, "m: closer bins (leakage) are ignored")
+          ->capture_default_str()
+          ->check(cli::atLeast(0));
+      app.add_option("--max-range", a->opt.max_range, "m: farther bins are ignored")
+          ->check(cli::positive());
       app.add_option("--max-shift", a->opt.max_shift, "m: largest range shift between chirps searched")
-          ->capture_default_str();
-      app.add_option("--alpha", a->opt.alpha, "False-alarm probability of the detection test")->capture_default_str();
+          ->capture_default_str()
+          ->check(cli::positive());
+      app.add_option("--alpha", a->opt.alpha, "False-alarm probability of the detection test")
+          ->capture_default_str()
+          ->check(cli::inRange(1e-300, 0.5));
       app.callback([a] { runChirpDoppler(*a); });
     });

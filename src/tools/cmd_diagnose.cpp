@@ -1,10 +1,14 @@
 // `spinradar diagnose`: sim-vs-real diagnosis of a recording (docs/diagnose.md).
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 
+#include "cli_checks.hpp"
 #include "command.hpp"
+#include "spinradar/core/safe_output.hpp"
 #include "spinradar/io/scan_folder.hpp"
 #include "spinradar/diagnose/appearance.hpp"
 #include "spinradar/diagnose/chirp_doppler.hpp"
@@ -64,11 +68,11 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
 
 /// The recording as a scan folder: a rosbag of RadarScan messages is first unpacked into
 /// <out>/recording_from_bag (Oxford layout).
-std::string recordingFolder(const DiagnoseArgs& a) {
+std::string recordingFolder(const DiagnoseArgs& a, const std::string& out) {
   if (!(fs::is_regular_file(a.recording) && fs::path(a.recording).extension() == ".bag"))
     return a.recording;
 #ifdef SPINRADAR_HAVE_BAG
-  const std::string dir = (fs::path(a.out) / "recording_from_bag").string();
+  const std::string dir = (fs::path(out) / "recording_from_bag").string();
   fs::remove_all(dir);
   const size_t n = bag::bagToFolder(a.recording, dir);
   std::cout << "read " << n << " scans from " << a.recording << "\n";
@@ -112,17 +116,63 @@ void printTiming(const diagnose::TimingReport& t) {
                 << r["verdict"].get<std::string>() << "\n";
 }
 
+/// Stamps the timing and catalogue stages can use: not all equal (all-zero stamps would read as
+/// "uniform, interval 0").
+void checkStamps(const std::vector<PolarScan>& scans, const std::string& name) {
+  size_t flat = 0;
+  for (const auto& s : scans) flat += s.firstStamp() == s.lastStamp();
+  const bool same_scan_times =
+      scans.size() > 1 && std::all_of(scans.begin(), scans.end(), [&](const PolarScan& s) {
+        return s.firstStamp() == scans.front().firstStamp();
+      });
+  if (flat == scans.size() || same_scan_times)
+    throw std::runtime_error(name + ": the azimuth stamps carry no time (" +
+                             std::to_string(flat) + " of " + std::to_string(scans.size()) +
+                             " scans have one stamp for every azimuth" +
+                             (same_scan_times ? ", every scan starts at the same time" : "") +
+                             "); the diagnosis needs the recorded stamps");
+}
+
+/// The trajectory must cover the recording (same clock); a trajectory of another drive would
+/// otherwise read as "no significant mismatch".
+void checkOverlap(const std::vector<PolarScan>& scans, const sim::Trajectory& traj,
+                  const std::string& traj_path, const std::string& rec) {
+  const double r0 = scans.front().firstStamp() * 1e-9, r1 = scans.back().lastStamp() * 1e-9;
+  const double t0 = traj.startTime(), t1 = traj.endTime();
+  const double overlap = std::min(r1, t1) - std::max(r0, t0);
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                "%s covers %.3f .. %.3f s but the scans of %s span %.3f .. %.3f s", traj_path.c_str(),
+                t0, t1, rec.c_str(), r0, r1);
+  if (!(overlap > 0))
+    throw std::runtime_error(std::string(buf) + ": they do not overlap (another drive, or "
+                                                "another clock?)");
+  if (overlap < 0.9 * (r1 - r0))
+    std::cerr << "warning: " << buf << ": only " << int(100.0 * overlap / (r1 - r0))
+              << " % of the recording has a trajectory\n";
+}
+
 void run(const DiagnoseArgs& a) {
   ScanFolderOptions fo;
   if (a.range_resolution > 0) fo.range_resolution = a.range_resolution;
-  const std::string dir = recordingFolder(a);
+  refuseOutputOverInput({a.out, "--out"}, {{a.recording, "--recording"}, {a.trajectory, "--trajectory"},
+                                           {a.world, "--world"}, {a.base, "--base"}}, true);
+  // The report is written aside and moved into the --out folder when complete (files of an
+  // older report there are replaced, others kept).
+  AtomicOutputFolder out_dir(a.out, true, "--out", false);
+  const std::string out = out_dir.tempPath();
+  const std::string dir = recordingFolder(a, out);
   ScanFolder folder(dir, parseScanFormat(a.format), fo);
   if (folder.empty()) throw std::runtime_error(a.recording + ": no radar scans found");
   diagnose::DiagnoseInput in;
   const size_t end = a.max_scans < 0 ? folder.size()
                                      : std::min(folder.size(), size_t(a.first_scan + a.max_scans));
   for (size_t i = a.first_scan; i < end; ++i) in.scans.push_back(folder.load(i));
-  if (in.scans.empty()) throw std::runtime_error(a.recording + ": no scans in the chosen range");
+  if (in.scans.empty())
+    throw std::runtime_error(a.recording + ": no scans in the chosen range (--first-scan " +
+                             std::to_string(a.first_scan) + " of " + std::to_string(folder.size()) +
+                             " scans)");
+  checkStamps(in.scans, a.recording);
   in.sensor = sensorFor(a, dir, in.scans);
   // The timing stage needs only the stamps: run it alone when asked, or when no trajectory is
   // given, or when the catalogue stage cannot run on this recording (report why).
@@ -131,7 +181,8 @@ void run(const DiagnoseArgs& a) {
         diagnose::analyseStamps(in.scans, in.sensor.rotation_hz, diagnose::TimingOptions{});
     diagnose::adviseTiming(t, 0, 0);
     t.chirp_doppler = diagnose::chirpDopplerSummary(in.scans, diagnose::chirpOptionsFor(in.base));
-    diagnose::writeTimingReport(t, a.out, why);
+    diagnose::writeTimingReport(t, out, why);
+    out_dir.commit();
     std::cout << "catalogue stage not run: " << why << "\n";
     printTiming(t);
     std::cout << "report in " << a.out << "\n";
@@ -144,6 +195,7 @@ void run(const DiagnoseArgs& a) {
   }
   if (!a.world.empty()) in.world = sim::World::load(a.world);
   in.trajectory = sim::Trajectory::loadCsv(a.trajectory);
+  checkOverlap(in.scans, in.trajectory, a.trajectory, a.recording);
   for (auto& s : in.scans) s.range_resolution = in.sensor.range_resolution;
 
   diagnose::DiagnoseOptions opt;
@@ -157,7 +209,8 @@ void run(const DiagnoseArgs& a) {
     timingOnly(e.what());
     return;
   }
-  diagnose::writeReport(rep, a.out);
+  diagnose::writeReport(rep, out);
+  out_dir.commit();
   std::cout << (!rep.mismatch_found        ? "no significant mismatch"
                 : rep.effects.empty()         ? "mismatch found (timing only, below)"
                                               : "mismatch found:");
@@ -197,9 +250,18 @@ SPINRADAR_COMMAND(
                      "Range bin size in m (default: sensor.json of the recording, else 0.0438)");
       app.add_option("--out", a->out, "Output folder (report.json, summary.md, PNG plots)")
           ->required();
-      app.add_option("--first-scan", a->first_scan, "First scan of the recording to use");
-      app.add_option("--max-scans", a->max_scans, "Use at most this many scans (-1: all)");
-      app.add_option("--alpha", a->alpha, "Family-wise significance level (Holm)");
+      app.add_option("--first-scan", a->first_scan, "First scan of the recording to use")
+          ->check(cli::atLeast(0));
+      app.add_option("--max-scans", a->max_scans, "Use at most this many scans (-1: all)")
+          ->check(CLI::Validator(
+              [](std::string& v) -> std::string {
+                return v == "-1" || (std::atoi(v.c_str()) >= 1 && v.find_first_not_of("0123456789") == std::string::npos)
+                           ? std::string()
+                           : v + " is not a count of scans (1 or more, or -1 for all)";
+              },
+              "", "COUNT"));
+      app.add_option("--alpha", a->alpha, "Family-wise significance level (Holm)")
+          ->check(cli::inRange(1e-12, 0.5));
       app.add_option("--seed", a->seed, "Noise seed of the re-simulation");
       app.add_flag("--no-resimulate", a->no_resimulate,
                    "Skip re-rendering with the fitted effects (use the linear model's residuals)");

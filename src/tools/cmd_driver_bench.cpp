@@ -10,6 +10,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "cli_checks.hpp"
 #include "command.hpp"
 #include "spinradar/driver/navtech_driver.hpp"
 #include "spinradar/driver/navtech_server.hpp"
@@ -106,10 +107,10 @@ SPINRADAR_COMMAND("driver-bench", "Measure the Navtech driver's CPU use and late
                     auto azimuths = std::make_shared<int>(400);
                     auto bins = std::make_shared<int>(3768);
                     auto depth = std::make_shared<int>(8);
-                    app.add_option("--rates", *rates, "Multiples of real time to measure")->capture_default_str();
-                    app.add_option("--seconds", *seconds, "Measurement time per rate")->capture_default_str();
-                    app.add_option("--azimuths", *azimuths, "Azimuths per rotation")->capture_default_str();
-                    app.add_option("--bins", *bins, "Range bins per azimuth")->capture_default_str();
+                    app.add_option("--rates", *rates, "Multiples of real time to measure")->capture_default_str()->check(spinradar::cli::positive());
+                    app.add_option("--seconds", *seconds, "Measurement time per rate")->capture_default_str()->check(spinradar::cli::positive());
+                    app.add_option("--azimuths", *azimuths, "Azimuths per rotation")->capture_default_str()->check(spinradar::cli::inRange(16, 20000));
+                    app.add_option("--bins", *bins, "Range bins per azimuth")->capture_default_str()->check(spinradar::cli::inRange(16, 65536));
                     app.add_option("--bit-depth", *depth, "FFT data: 8 (type 30) or 16 (type 31)")
                         ->check(CLI::IsMember({8, 16}))
                         ->capture_default_str();

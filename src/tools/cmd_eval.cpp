@@ -13,7 +13,9 @@
 #include <Eigen/LU>
 #include <nlohmann/json.hpp>
 
+#include "cli_checks.hpp"
 #include "command.hpp"
+#include "output_guard.hpp"
 #include "spinradar/evaluation/evaluation.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/evaluation/plot.hpp"
@@ -255,6 +257,12 @@ void run(EvalArgs& a) {
   if (!a.cov.empty() && a.cov.size() != a.est.size())
     throw std::runtime_error("--covariance given " + std::to_string(a.cov.size()) +
                              " times for " + std::to_string(a.est.size()) + " --est files");
+  // Outputs: never an input, checked (and --plot's image type) before any work.
+  std::vector<NamedPath> inputs{{a.gt, "--gt"}};
+  for (const auto& e : a.est) inputs.push_back({e, "--est"});
+  for (const auto& c : a.cov) inputs.push_back({c, "--covariance"});
+  cli::refuseOutputsOverInputs({{a.json, "--json"}, {a.plot, "--plot"}}, inputs);
+  if (!a.plot.empty()) plot::checkImagePath(a.plot);
   std::vector<std::string> labels = a.labels;
   if (labels.empty())
     for (const auto& e : a.est) labels.push_back(std::filesystem::path(e).stem().string());
@@ -296,9 +304,9 @@ void run(EvalArgs& a) {
     }
   }
   if (!a.json.empty()) {
-    std::ofstream out(a.json);
-    if (!out) throw std::runtime_error(a.json + ": cannot open for writing");
-    out << all.dump(1) << "\n";
+    AtomicOutputFile out(a.json);
+    out.stream() << all.dump(1) << "\n";
+    out.commit();
   }
   if (!a.plot.empty()) {
     savePlots(reports, labels, a.plot);
@@ -340,8 +348,9 @@ SPINRADAR_COMMAND(
       app.add_option("--json", a->json, "Write the figures as JSON");
       app.add_option("--step", a->step,
                      "First frames every N frames (KITTI devkit: 10; 4 = every second at 4 Hz)")
-          ->check(CLI::PositiveNumber);
+          ->check(cli::atLeast(1));
       app.add_option("--list-frames", a->frames_listed,
-                     "List every frame-to-frame error when there are at most this many");
+                     "List every frame-to-frame error when there are at most this many")
+          ->check(cli::atLeast(0));
       app.callback([a] { run(*a); });
     });

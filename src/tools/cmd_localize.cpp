@@ -12,7 +12,9 @@
 #include <memory>
 #include <sstream>
 
+#include "cli_checks.hpp"
 #include "command.hpp"
+#include "output_guard.hpp"
 #include "pipeline_options.hpp"
 #include "progress.hpp"
 #include "spinradar/evaluation/evaluation.hpp"
@@ -77,7 +79,7 @@ std::string modePath(const std::string& out, Compensation c, bool several) {
 
 struct ModeState {
   Compensation comp;
-  std::ofstream csv;
+  std::unique_ptr<AtomicOutputFile> file;  // renamed onto `path` when the run completes
   std::string path;
   bool have_last = false;
   Eigen::Matrix3d T_last = Eigen::Matrix3d::Identity();
@@ -135,6 +137,10 @@ void runLocalize(LocalizeArgs& a) {
   if (!a.truth.empty()) truth = readPoseCsv(a.truth).poses;
   if (a.prior == "truth" && truth.empty()) throw std::runtime_error("--prior truth needs --truth");
 
+  if (!a.plot.empty()) {
+    if (truth.empty()) throw std::runtime_error("--plot needs --truth (it plots the errors)");
+    plot::checkImagePath(a.plot);
+  }
   Localizer loc(a.loc, a.rsd, pipeline);
   {
     std::unique_ptr<cli::Progress> progress;
@@ -146,6 +152,15 @@ void runLocalize(LocalizeArgs& a) {
   }
 
   ScanFolder live(a.input);
+  {
+    std::vector<NamedPath> inputs = cli::scanFolderInputs(live, "--input");
+    for (const auto& p : cli::scanFolderInputs(ScanFolder(a.map), "--map")) inputs.push_back(p);
+    inputs.insert(inputs.end(), {{a.map_poses, "--map-poses"}, {a.truth, "--truth"},
+                                 {a.pipeline.configPath(), "--config"}});
+    std::vector<NamedPath> outputs{{a.plot, "--plot"}};
+    for (Compensation c : comps) outputs.push_back({modePath(a.out, c, comps.size() > 1), "--out"});
+    cli::refuseOutputsOverInputs(outputs, inputs);
+  }
   std::vector<size_t> idx;
   for (size_t i = 0; i < live.size(); ++i) {
     const double t = 1e-9 * static_cast<double>(live.fileStampNs(i));
@@ -159,10 +174,10 @@ void runLocalize(LocalizeArgs& a) {
     auto m = std::make_unique<ModeState>();
     m->comp = c;
     m->path = modePath(a.out, c, several);
-    m->csv.open(m->path);
-    if (!m->csv) throw std::runtime_error(m->path + ": cannot write");
-    m->csv << "t,x,y,yaw,ok,map_t,matches,inliers,velocity_known" << (truth.empty() ? "" : ",err_trans,err_rot_deg") << "\n";
-    m->csv << std::fixed << std::setprecision(6);  // UNIX-time stamps need the decimals
+    m->file = std::make_unique<AtomicOutputFile>(m->path);
+    std::ofstream& csv = m->file->stream();
+    csv << "t,x,y,yaw,ok,map_t,matches,inliers,velocity_known" << (truth.empty() ? "" : ",err_trans,err_rot_deg") << "\n";
+    csv << std::fixed << std::setprecision(9);  // UNIX-time stamps need the decimals
     modes.push_back(std::move(m));
   }
   const bool have_initial = !a.initial_pose.empty();
@@ -197,6 +212,7 @@ void runLocalize(LocalizeArgs& a) {
 
     for (auto& mp : modes) {
       ModeState& m = *mp;
+      std::ofstream& csv = m.file->stream();
       LocalizationResult r;
       if (a.prior == "truth") {
         if (!have_truth) continue;  // outside the truth's span: nothing to localize with
@@ -221,26 +237,26 @@ void runLocalize(LocalizeArgs& a) {
       const Eigen::Vector3d p = se2::toXyYaw(r.T_map_sensor);
       const double map_t =
           r.map_index >= 0 ? 1e-9 * static_cast<double>(loc.mapFrame(r.map_index).stamp_ns) : std::nan("");
-      m.csv << t << ',' << p(0) << ',' << p(1) << ',' << p(2) << ',' << (r.ok ? 1 : 0) << ','
+      csv << t << ',' << p(0) << ',' << p(1) << ',' << p(2) << ',' << (r.ok ? 1 : 0) << ','
             << map_t << ',' << r.matches << ',' << r.inliers << ',' << (r.velocity_known ? 1 : 0);
       if (!truth.empty()) {
         if (have_truth && r.ok) {
           const Eigen::Vector3d e = se2::toXyYaw(se2::inverse(T_true) * r.T_map_sensor);
           const double et = e.head<2>().norm(), er = std::abs(e(2)) * 180.0 / M_PI;
-          m.csv << ',' << et << ',' << er;
+          csv << ',' << et << ',' << er;
           if (speed >= a.min_speed) {
             m.err_t.push_back(et);
             m.err_r.push_back(er);
           }
         } else {
-          m.csv << ",nan,nan";
+          csv << ",nan,nan";
         }
         if (have_truth && speed >= a.min_speed) {
           ++m.evaluated;
           if (!r.ok) ++m.failures;
         }
       }
-      m.csv << '\n';
+      csv << '\n';
     }
     progress.update(k + 1);
   }
@@ -255,9 +271,11 @@ void runLocalize(LocalizeArgs& a) {
                   median(m->err_t), median(m->err_r));
     if (a.min_speed > 0.0) std::printf("(live scans at >= %.1f m/s only)\n", a.min_speed);
   }
-  for (const auto& m : modes) std::cerr << "localize: wrote " << m->path << "\n";
+  for (const auto& m : modes) {
+    m->file->commit();
+    std::cerr << "localize: wrote " << m->path << "\n";
+  }
   if (!a.plot.empty()) {
-    if (truth.empty()) throw std::runtime_error("--plot needs --truth (it plots the errors)");
     savePlot(modes, a.plot);
     std::cerr << "localize: wrote " << a.plot << "\n";
   }
@@ -287,7 +305,9 @@ SPINRADAR_COMMAND(
       app.add_option("--initial-pose", a->initial_pose,
                      "x,y,yaw of the first live scan for --prior track (default: global search)");
       app.add_option("--global-stride", a->global_stride,
-                     "Global search tries every n-th map scan")->capture_default_str();
+                     "Global search tries every n-th map scan")
+          ->capture_default_str()
+          ->check(cli::atLeast(1));
       app.add_option("--input-from", a->input_from, "Only live scans from this time (s)");
       app.add_option("--input-to", a->input_to, "Only live scans up to this time (s)");
       app.add_option("--min-speed", a->min_speed,
@@ -297,5 +317,20 @@ SPINRADAR_COMMAND(
       addParams(app, a->loc, "Localizer parameters", "compensation");
       addParams(app, a->rsd, "RSD parameters");
       a->pipeline.add(app);
+      // --config may also set the localizer and RSD parameters (options given still win).
+      CLI::App* self = &app;
+      a->pipeline.setExtraParams([a, self](const std::string& name, const std::string& value,
+                                           const std::string& where) {
+        LocalizerConfig loc = a->loc;
+        RsdConfig rsd = a->rsd;
+        const bool is_loc = cli::setParamByName(loc, name, value, where);
+        const bool is_rsd = !is_loc && cli::setParamByName(rsd, name, value, where);
+        if (!is_loc && !is_rsd) return false;
+        const CLI::Option* given = self->get_option_no_throw("--" + name);
+        if (given && given->count() > 0) return true;  // the command line overrides the file
+        if (is_loc) a->loc = loc;
+        else a->rsd = rsd;
+        return true;
+      });
       app.callback([a] { runLocalize(*a); });
     });

@@ -15,7 +15,9 @@
 
 #include <tbb/global_control.h>
 
+#include "cli_checks.hpp"
 #include "command.hpp"
+#include "output_guard.hpp"
 #include "pipeline_options.hpp"
 #include "progress.hpp"
 #include "spinradar/estimation/odometry.hpp"
@@ -43,7 +45,7 @@ class ScanPrefetcher {
   struct Loaded {
     PolarScan scan;
     double load_ms = 0;
-    std::exception_ptr error;
+    std::string error;  ///< why the scan could not be read ("" when it was)
   };
   ScanPrefetcher(const ScanFolder& folder, size_t depth)
       : folder_(folder), depth_(std::max<size_t>(1, depth)), thread_([this] { loop(); }) {}
@@ -56,7 +58,7 @@ class ScanPrefetcher {
     thread_.join();
   }
   /// The next scan in folder order and its load time (ms); `wait_ms` += time spent waiting.
-  std::pair<PolarScan, double> take(double& wait_ms) {
+  Loaded take(double& wait_ms) {
     const auto t0 = std::chrono::steady_clock::now();
     std::unique_lock<std::mutex> lock(mutex_);
     cv_.wait(lock, [this] { return !ready_.empty(); });
@@ -65,8 +67,7 @@ class ScanPrefetcher {
     lock.unlock();
     cv_.notify_all();
     wait_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (item.error) std::rethrow_exception(item.error);
-    return {std::move(item.scan), item.load_ms};
+    return item;
   }
 
  private:
@@ -81,17 +82,15 @@ class ScanPrefetcher {
       const auto t0 = std::chrono::steady_clock::now();
       try {
         item.scan = folder_.load(i);
-      } catch (...) {
-        item.error = std::current_exception();
+      } catch (const std::exception& e) {
+        item.error = e.what();  // the consumer warns and skips it
       }
       item.load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      const bool failed = static_cast<bool>(item.error);
       {
         std::lock_guard<std::mutex> lock(mutex_);
         ready_.push_back(std::move(item));
       }
       cv_.notify_all();
-      if (failed) return;
     }
   }
 
@@ -133,6 +132,10 @@ void run(OdometryArgs& a) {
   if (a.range_resolution > 0) opts.range_resolution = a.range_resolution;
   const ScanFolder folder(a.input, parseScanFormat(a.format), opts);
   if (folder.empty()) throw std::runtime_error(folder.folder() + ": no scans found");
+  std::vector<NamedPath> inputs = cli::scanFolderInputs(folder, "--input");
+  inputs.push_back({a.pipeline.configPath(), "--config"});
+  cli::refuseOutputsOverInputs(
+      {{a.out, "--out"}, {a.tum_out, "--tum"}, {a.cov_out, "--covariance-out"}}, inputs);
 
   std::optional<tbb::global_control> limit;
   if (a.threads > 0)
@@ -143,16 +146,16 @@ void run(OdometryArgs& a) {
 
   Odometry odometry(cfg);
   PoseCsvWriter writer(a.out);
-  std::ofstream tum;
-  if (!a.tum_out.empty()) {
-    tum.open(a.tum_out);
-    if (!tum) throw std::runtime_error(a.tum_out + ": cannot open for writing");
-  }
-  std::ofstream cov;
-  if (!a.cov_out.empty()) {
-    cov.open(a.cov_out);
-    if (!cov) throw std::runtime_error(a.cov_out + ": cannot open for writing");
-    cov.precision(10);
+  // Every output goes to a temporary file renamed when the run completes: a failed run
+  // leaves nothing behind.
+  std::optional<AtomicOutputFile> tum_file, cov_file;
+  std::ostream* tum = nullptr;
+  std::ostream* covp = nullptr;
+  if (!a.tum_out.empty()) tum = &tum_file.emplace(a.tum_out).stream();
+  if (!a.cov_out.empty()) covp = &cov_file.emplace(a.cov_out).stream();
+  std::ostream& cov = covp ? *covp : std::cerr;
+  if (covp) {
+    cov.precision(17);  // full precision: `eval --covariance` matches its times to the poses'
     cov << "t,ok,pose_xx,pose_xy,pose_xyaw,pose_yy,pose_yyaw,pose_yawyaw,"
            "step_xx,step_xy,step_xyaw,step_yy,step_yyaw,step_yawyaw,"
            "vel_xx,vel_xy,vel_xw,vel_yy,vel_yw,vel_ww,"
@@ -169,20 +172,41 @@ void run(OdometryArgs& a) {
   size_t failures = 0;
   const auto wall0 = std::chrono::steady_clock::now();
   auto timedLoad = [&folder](size_t i) {
+    ScanPrefetcher::Loaded l;
     const auto t0 = std::chrono::steady_clock::now();
-    PolarScan s = folder.load(i);
-    const double ms =
+    try {
+      l.scan = folder.load(i);
+    } catch (const std::exception& e) {
+      l.error = e.what();
+    }
+    l.load_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    return std::make_pair(std::move(s), ms);
+    return l;
   };
+  // A scan that cannot be read is skipped with a warning naming it (a long recording is still
+  // worth its other scans); the run stops when the first three all fail or none can be read.
+  size_t skipped = 0, processed = 0;
+  std::string first_error;
   // With more than one thread the next scans are read while this one is processed.
   const bool prefetch = a.threads != 1;
   double wait_ms = 0;
   std::optional<ScanPrefetcher> prefetcher;
   if (prefetch) prefetcher.emplace(folder, 3);
   for (size_t i = 0; i < folder.size(); ++i) {
-    auto [scan, ms] = prefetch ? prefetcher->take(wait_ms) : timedLoad(i);
-    load_ms += ms;
+    ScanPrefetcher::Loaded l = prefetch ? prefetcher->take(wait_ms) : timedLoad(i);
+    load_ms += l.load_ms;
+    if (!l.error.empty()) {
+      ++skipped;
+      if (first_error.empty()) first_error = l.error;
+      if (processed == 0 && skipped >= 3)
+        throw std::runtime_error(first_error + " (and the next " + std::to_string(skipped - 1) +
+                                 " scans fail too: wrong --format or not scans?)");
+      if (skipped <= 10) std::fprintf(stderr, "\nwarning: %s: scan skipped\n", l.error.c_str());
+      if (skipped == 10) std::fprintf(stderr, "warning: further skipped scans are only counted\n");
+      continue;
+    }
+    ++processed;
+    PolarScan& scan = l.scan;
     const OdometryResult r = odometry.process(scan);
     totals += r.times;
     if (i > 0 && !r.ok) ++failures;
@@ -197,14 +221,17 @@ void run(OdometryArgs& a) {
       p.wz = r.motion.velocity(2);
     }
     writer.write(p);
-    if (tum.is_open()) writeTumRow(tum, p);
-    if (cov.is_open()) {
+    if (tum) writeTumRow(*tum, p);
+    if (covp) {
       const Eigen::Matrix3d& K = r.T_keyframe_sensor;
-      cov << p.t << ',' << (r.ok ? 1 : 0);
+      char t[64];
+      std::snprintf(t, sizeof t, "%.9f", p.t);  // as the pose CSV writes its times
+      cov << t << ',' << (r.ok ? 1 : 0);
       writeCov(r.pose_cov);
       writeCov(r.motion.T_12_cov);
       writeCov(r.motion.velocity_cov);
-      cov << ',' << r.keyframe_stamp_ns * 1e-9 << ',' << K(0, 2) << ',' << K(1, 2) << ','
+      std::snprintf(t, sizeof t, "%.9f", r.keyframe_stamp_ns * 1e-9);
+      cov << ',' << t << ',' << K(0, 2) << ',' << K(1, 2) << ','
           << std::atan2(K(1, 0), K(0, 0));
       writeCov(r.keyframe_cov);
       cov << '\n';
@@ -212,18 +239,16 @@ void run(OdometryArgs& a) {
     if (!a.quiet)
       progress.update(i + 1, failures ? std::to_string(failures) + " failed estimate(s)" : "");
   }
+  if (processed == 0) throw std::runtime_error(first_error + " (no scan could be read)");
   writer.close();
-  if (tum.is_open()) {
-    tum.close();
-    if (!tum) throw std::runtime_error(a.tum_out + ": write failed");
-  }
-  if (cov.is_open()) {
-    cov.close();
-    if (!cov) throw std::runtime_error(a.cov_out + ": write failed");
-  }
+  if (tum_file) tum_file->commit();
+  if (cov_file) cov_file->commit();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   printStageTotals(totals, load_ms, wait_ms, prefetch, folder.size(), wall);
+  if (skipped)
+    std::fprintf(stderr, "warning: skipped %zu of %zu scans that could not be read (first: %s)\n",
+                 skipped, folder.size(), first_error.c_str());
   if (failures)
     std::fprintf(stderr, "warning: motion estimation failed on %zu of %zu scan pairs (pose held "
                          "as the odometry reported it)\n", failures, folder.size() - 1);
@@ -250,11 +275,11 @@ SPINRADAR_COMMAND(
       app.add_option("--range-resolution", a->range_resolution,
                      "Metres per range bin (default: the format's own; Oxford 0.0438, the "
                      "Oxford SDK uses 0.0432)")
-          ->check(CLI::PositiveNumber);
+          ->check(cli::positive());
       app.add_option("--threads", a->threads,
                      "Worker threads (TBB limit; >1 also reads the next scan in the background); "
                      "0 = all cores")
-          ->check(CLI::NonNegativeNumber);
+          ->check(cli::atLeast(0));
       app.add_flag("--quiet,-q", a->quiet, "No progress line");
       app.add_option("--tum", a->tum_out,
                      "Also write the poses in the TUM format (t x y z qx qy qz qw) that evo "

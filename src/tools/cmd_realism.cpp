@@ -1,6 +1,8 @@
 // `spinradar realism`: realism figures of simulated scans next to the real samples.
+#include <filesystem>
 #include <iostream>
 
+#include "cli_checks.hpp"
 #include "command.hpp"
 #include "spinradar/io/scan_folder.hpp"
 #include "spinradar/sim/realism.hpp"
@@ -18,12 +20,22 @@ struct RealismCmdOptions {
   uint64_t seed = 1;
   double min_range = 2.5, max_range = 100.0;
   bool no_detect = false;
+  bool no_real = false;
 };
 
 void runRealism(const RealismCmdOptions& o) {
   using namespace spinradar;
   using namespace spinradar::sim;
   RealismOptions ro;
+  if (!(o.min_range < o.max_range))
+    throw std::runtime_error("--min-range " + readableNumber(o.min_range) +
+                             " m is not below --max-range " + readableNumber(o.max_range) +
+                             " m: no cell would be compared");
+  // The real columns are the point of the table: a missing or empty folder is an error, not a
+  // table without them (--no-real compares simulations only).
+  if (!o.no_real && !std::filesystem::is_directory(o.realdata))
+    throw std::runtime_error(o.realdata + ": no such folder of real samples (--realdata; "
+                             "--no-real compares simulations only)");
   ro.min_range = o.min_range;
   ro.max_range = o.max_range;
   ro.detect = !o.no_detect;
@@ -37,6 +49,18 @@ void runRealism(const RealismCmdOptions& o) {
     physics = PhysicsConfig::load(o.physics);
   }
   SensorConfig sensor = o.sensor.empty() ? SensorConfig{} : SensorConfig::loadNamed(o.sensor);
+  // The real samples are read first: a missing or corrupt one stops the command before the
+  // (slow) simulations.
+  std::vector<std::pair<std::string, std::vector<PolarScan>>> real_cols;
+  if (!o.no_real) {
+    // A corrupt sample stops the command with its name (loaders name the file).
+    auto real = loadRealSamples(o.realdata);
+    if (real.empty())
+      throw std::runtime_error(o.realdata + ": no real samples found (expected "
+                               "oxford_2019-01-10-14-36-48/radar/*.png, mulran/*.csv, "
+                               "boreas_rt/test_frame.png or radiate_fog_6_0/Navtech_Polar/*.png)");
+    real_cols = std::move(real);
+  }
   for (const auto& name : o.scenes) {
     Scene sc = builtinScene(name);
     Simulator sim(sc.world, sc.trajectory, sensor, physics, o.seed);
@@ -52,11 +76,7 @@ void runRealism(const RealismCmdOptions& o) {
     for (size_t i = 0; i < n; ++i) scans.push_back(folder.load(i * folder.size() / n));
     cols.push_back(computeRealism(scans, dir, ro));
   }
-  try {
-    for (auto& [name, scans] : loadRealSamples(o.realdata)) cols.push_back(computeRealism(scans, name, ro));
-  } catch (const std::exception& e) {
-    std::cerr << "realism: real samples: " << e.what() << "\n";
-  }
+  for (auto& [name, scans] : real_cols) cols.push_back(computeRealism(scans, name, ro));
   std::cout << formatRealismTable(cols);
   std::cout << "\nCells " << o.min_range << "-" << o.max_range
             << " m. * RADIATE is rescaled (not native ~1 dB/count): compare its texture only.\n";
@@ -74,10 +94,18 @@ SPINRADAR_COMMAND("realism", "Compare simulated scans with the real samples (his
                     app.add_option("--recording", o->recordings, "Extra recording folders");
                     app.add_option("--physics", o->physics, "Physics JSON (default: distortion, Doppler, movers)");
                     app.add_option("--sensor", o->sensor, "Sensor: JSON file or calibrated name (oxford, mulran, boreas_rt, radiate)");
-                    app.add_option("--scans", o->scans, "Scans per simulated scene")->capture_default_str();
+                    app.add_option("--scans", o->scans, "Scans per simulated scene")
+                        ->capture_default_str()
+                        ->check(spinradar::cli::atLeast(1));
                     app.add_option("--seed", o->seed, "Noise seed")->capture_default_str();
-                    app.add_option("--min-range", o->min_range, "m")->capture_default_str();
-                    app.add_option("--max-range", o->max_range, "m")->capture_default_str();
+                    app.add_option("--min-range", o->min_range, "m")
+                        ->capture_default_str()
+                        ->check(spinradar::cli::atLeast(0));
+                    app.add_option("--max-range", o->max_range, "m")
+                        ->capture_default_str()
+                        ->check(spinradar::cli::positive());
+                    app.add_flag("--no-real", o->no_real,
+                                 "Compare simulations (and --recording folders) only");
                     app.add_flag("--no-detect", o->no_detect, "Skip the detectors");
                     app.callback([o] { runRealism(*o); });
                   });

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <thread>
 
+#include "cli_checks.hpp"
 #include "command.hpp"
 #include "spinradar/driver/navtech_server.hpp"
 #include "spinradar/sim/physics.hpp"
@@ -86,11 +87,13 @@ SPINRADAR_COMMAND("serve", "Serve a simulated scene as a live Navtech radar (TCP
                     app.add_option("--scene", o->scene, "Built-in scene: city, out_and_back or tight_turns")
                         ->capture_default_str();
                     app.add_option("--port", o->port, "TCP port (Navtech default 6317; 0 = any free port)")
-                        ->capture_default_str();
+                        ->capture_default_str()
+                        ->check(spinradar::cli::inRange(0, 65535));
                     app.add_option("--bind", o->bind, "Address to listen on (keep it loopback unless you mean it)")
                         ->capture_default_str();
                     app.add_option("--rate", o->rate, "Multiple of real time (0 = as fast as the client reads)")
-                        ->capture_default_str();
+                        ->capture_default_str()
+                        ->check(spinradar::cli::atLeast(0));
                     app.add_option("--physics", o->physics,
                                    "Physics configuration: a JSON file or an inline JSON object, e.g. "
                                    "'{\"motion_distortion\": true, \"doppler\": 0.049}'");

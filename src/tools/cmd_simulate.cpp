@@ -6,7 +6,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_checks.hpp"
 #include "command.hpp"
+#include "spinradar/core/safe_output.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
 #ifdef SPINRADAR_HAVE_BAG
@@ -23,6 +25,7 @@ struct SimulateOptions {
   int first = 0;
   double t0 = 0.0;
   bool list = false;
+  bool force = false;
 };
 
 void runSimulate(const SimulateOptions& o) {
@@ -37,6 +40,16 @@ void runSimulate(const SimulateOptions& o) {
     return;
   }
   if (o.out.empty()) throw std::runtime_error("--out is required");
+  const std::vector<spinradar::NamedPath> inputs{{o.world, "--world"}, {o.trajectory, "--trajectory"},
+                                                 {o.physics, "--physics"}, {o.sensor, "--sensor"}};
+  spinradar::refuseOutputOverInput({o.out, "--out"}, inputs, true);
+  if (!o.bag.empty()) {
+    spinradar::refuseOutputOverInput({o.bag, "--bag"}, inputs);
+    spinradar::refuseOutputOverInput({o.bag, "--bag"}, {{o.out, "--out"}}, false);
+  }
+  // The recording is written aside and moved into place when complete (--force: over the old
+  // scans of a non-empty folder).
+  spinradar::AtomicOutputFolder out_dir(o.out, o.force);
   World world;
   Trajectory traj;
   if (!o.scene.empty()) {
@@ -58,7 +71,10 @@ void runSimulate(const SimulateOptions& o) {
   std::cerr << "simulate: " << total << " rotations available, physics "
             << sim.physics().toJson().dump() << ", seed " << o.seed << "\n";
   auto start = std::chrono::steady_clock::now();
-  int n = writeRecording(sim, o.out, o.first, o.scans, true);
+  if (o.first >= total)
+    throw std::runtime_error("--first " + std::to_string(o.first) + ": the scene has only " +
+                             std::to_string(total) + " rotations");
+  int n = writeRecording(sim, out_dir.tempPath(), o.first, o.scans, true);
   double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cerr << "simulate: wrote " << n << " scans to " << o.out << " in " << secs << " s ("
             << (secs > 0 ? n / secs : 0.0) << " scans/s including PNG encoding)\n";
@@ -68,13 +84,17 @@ void runSimulate(const SimulateOptions& o) {
     bo.rotation_hz = sensor.rotation_hz;
     spinradar::ScanFolderOptions fo;
     fo.range_resolution = sensor.range_resolution;
+    spinradar::AtomicOutputFile bag_file(o.bag);
     const size_t m = spinradar::bag::folderToBag(
-        spinradar::ScanFolder(o.out, spinradar::ScanFormat::Oxford, fo), o.bag, bo);
+        spinradar::ScanFolder(out_dir.tempPath(), spinradar::ScanFormat::Oxford, fo),
+        bag_file.tempPath(), bo);
+    bag_file.commit();
     std::cerr << "simulate: wrote " << m << " RadarScan messages to " << o.bag << "\n";
 #else
     throw std::runtime_error("--bag needs spinradar built with ROS (catkin)");
 #endif
   }
+  out_dir.commit();
 }
 
 }  // namespace
@@ -94,9 +114,17 @@ SPINRADAR_COMMAND("simulate", "Simulate a recording (Oxford polar PNGs + true tr
                         ->capture_default_str();
                     app.add_option("--t0", o->t0, "Built-in scene start time (s)")
                         ->capture_default_str();
-                    app.add_option("--scans", o->scans, "Number of scans (default: all)");
-                    app.add_option("--first", o->first, "First scan index")->capture_default_str();
-                    app.add_option("--out", o->out, "Output recording folder");
+                    app.add_option("--scans", o->scans, "Number of scans (default: all)")
+                        ->check(spinradar::cli::atLeast(1));
+                    app.add_option("--first", o->first, "First scan index")
+                        ->capture_default_str()
+                        ->check(spinradar::cli::atLeast(0));
+                    app.add_option("--out", o->out,
+                                   "Output recording folder (new or empty; written aside and "
+                                   "moved into place when complete)");
+                    app.add_flag("--force", o->force,
+                                 "Write into a non-empty --out folder: its old scans (radar/, "
+                                 "radar.timestamps) are removed first");
                     app.add_option("--bag", o->bag,
                                    "Also write the scans as a rosbag of spinradar/RadarScan");
                     app.add_flag("--list-scenes", o->list, "List the built-in scenes and exit");

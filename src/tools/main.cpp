@@ -3,6 +3,7 @@
 #include <exception>
 #include <iostream>
 
+#include "cli_checks.hpp"
 #include "command.hpp"
 
 namespace spinradar::cli {
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   auto& list = commands();
   std::sort(list.begin(), list.end(), [](const Command& a, const Command& b) { return a.name < b.name; });
   for (auto& c : list) c.setup(*app.add_subcommand(c.name, c.summary));
+  requireFiniteNumbers(app);  // NaN and infinities are never valid, for every option
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -26,32 +26,6 @@ std::string defaultText(const T& v) {
   return o.str();
 }
 
-template <class T>
-T parseValue(const std::string& text, const std::string& where, const char* name) {
-  auto bad = [&](const std::string& why) {
-    return std::invalid_argument(where + ": parameter '" + name + "': '" + text + "' " + why);
-  };
-  if constexpr (std::is_same_v<T, std::string>) {
-    return text;
-  } else if constexpr (std::is_same_v<T, bool>) {
-    if (text == "true" || text == "1" || text == "on" || text == "yes") return true;
-    if (text == "false" || text == "0" || text == "off" || text == "no") return false;
-    throw bad("is not a boolean (true/false)");
-  } else if constexpr (std::is_integral_v<T>) {
-    errno = 0;
-    char* end = nullptr;
-    const long v = std::strtol(text.c_str(), &end, 10);
-    if (text.empty() || *end != '\0' || errno == ERANGE) throw bad("is not an integer");
-    return static_cast<T>(v);
-  } else {
-    errno = 0;
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    if (text.empty() || *end != '\0' || errno == ERANGE) throw bad("is not a number");
-    return static_cast<T>(v);
-  }
-}
-
 template <class Group>
 bool hasParam(const Group& g, const std::string& name) {
   bool found = false;
@@ -60,10 +34,15 @@ bool hasParam(const Group& g, const std::string& name) {
 }
 
 void applyMap(const YAML::Node& map, PipelineConfig& cfg, const std::string& path,
-              const std::string& prefix) {
+              const std::string& prefix, const ExtraParamSetter& extra) {
+  std::map<std::string, int> seen;  // YAML keeps one of two equal keys silently: refuse them
   for (const auto& kv : map) {
     const std::string key = kv.first.as<std::string>();
     const std::string where = path + ":" + std::to_string(kv.first.Mark().line + 1);
+    const auto [it, fresh] = seen.emplace(key, kv.first.Mark().line + 1);
+    if (!fresh)
+      throw std::invalid_argument(where + ": '" + prefix + key + "' given twice (also on line " +
+                                  std::to_string(it->second) + ")");
     const YAML::Node& v = kv.second;
     if (v.IsMap()) {
       if (!prefix.empty() || (key != "detector" && key != "features" && key != "estimator"))
@@ -79,11 +58,12 @@ void applyMap(const YAML::Node& map, PipelineConfig& cfg, const std::string& pat
           throw std::invalid_argument(path + ":" + std::to_string(member.first.Mark().line + 1) +
                                       ": unknown " + key + " parameter '" + name + "'");
       }
-      applyMap(v, cfg, path, key + ".");
+      applyMap(v, cfg, path, key + ".", extra);
       continue;
     }
     if (!v.IsScalar())
       throw std::invalid_argument(where + ": parameter '" + key + "' needs a single value");
+    if (prefix.empty() && extra && extra(key, v.Scalar(), where)) continue;
     setPipelineParam(cfg, key, v.Scalar(), where);
   }
 }
@@ -102,7 +82,7 @@ void setPipelineParam(PipelineConfig& cfg, const std::string& name, const std::s
   if (!found) throw std::invalid_argument(where + ": unknown parameter '" + name + "'");
 }
 
-void loadPipelineYaml(const std::string& path, PipelineConfig& cfg) {
+void loadPipelineYaml(const std::string& path, PipelineConfig& cfg, const ExtraParamSetter& extra) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
@@ -115,7 +95,7 @@ void loadPipelineYaml(const std::string& path, PipelineConfig& cfg) {
   if (!root.IsMap())
     throw std::runtime_error(path + ": expected a map of parameter names to values");
   try {
-    applyMap(root, cfg, path, "");
+    applyMap(root, cfg, path, "", extra);
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
@@ -148,7 +128,7 @@ void PipelineOptions::add(CLI::App& app, const std::string& group) {
 
 PipelineConfig PipelineOptions::resolve() const {
   PipelineConfig cfg;
-  if (!config_path_.empty()) loadPipelineYaml(config_path_, cfg);
+  if (!config_path_.empty()) loadPipelineYaml(config_path_, cfg, extra_);
   for (const auto& [name, opt] : options_)
     if (opt->count() > 0) setPipelineParam(cfg, name, values_.at(name), "option --" + name);
   for (const auto& [name, value] : forced_) setPipelineParam(cfg, name, value, "--" + name);

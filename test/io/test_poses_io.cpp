@@ -46,10 +46,20 @@ TEST(PosesIo, RoundTripKeepsFullPrecision) {
 
 TEST(PosesIo, IncrementalWriter) {
   const std::string path = (fs::temp_directory_path() / "spinradar_test_poses_w.csv").string();
+  fs::remove(path);
+  {
+    PoseCsvWriter w(path, false);
+    w.write({1.0, 1, 2, 3});
+    // Not closed (a failed run): nothing appears, no temporary file stays behind.
+  }
+  EXPECT_FALSE(fs::exists(path));
+  for (const auto& e : fs::directory_iterator(fs::temp_directory_path()))
+    EXPECT_EQ(e.path().filename().string().find(".spinradar_test_poses_w.partial"), std::string::npos);
   {
     PoseCsvWriter w(path, false);
     w.write({1.0, 1, 2, 3});
     w.write({2.0, 4, 5, 6});
+    w.close();
   }
   const PoseFile f = readPoseCsv(path);
   EXPECT_FALSE(f.has_velocity);

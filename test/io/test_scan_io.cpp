@@ -215,15 +215,15 @@ TEST(ScanIo, MulranCsvParsesAndRejectsBadLines) {
   TempDir d;
   {
     std::ofstream f(d.file("100.csv"));
-    for (int a = 0; a < 4; ++a) {
+    for (int a = 0; a < 16; ++a) {
       f << (1000000000LL + a * 625000) << "," << (a * 0.9) << "," << (9 + 14 * a) << "," << (42 + a);
-      for (int b = 0; b < 6; ++b) f << "," << (a * 10 + b);
+      for (int b = 0; b < 16; ++b) f << "," << (a * 10 + b);
       f << "\n";
     }
   }
   const PolarScan s = loadMulranCsv(d.file("100.csv"));
-  ASSERT_EQ(s.azimuths, 4);
-  ASSERT_EQ(s.bins, 6);
+  ASSERT_EQ(s.azimuths, 16);
+  ASSERT_EQ(s.bins, 16);
   EXPECT_EQ(s.stamp_ns[3], 1000000000LL + 3 * 625000);
   EXPECT_EQ(s.row(2)[5], 25);
   EXPECT_NEAR(s.azimuth[1], 23.0 / 5600 * 2 * M_PI, 1e-12);

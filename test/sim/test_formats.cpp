@@ -161,7 +161,7 @@ TEST(SimFormats, PhysicsRoundTripKeepsExtrasAndListsActiveEffects) {
   auto j = nlohmann::json::parse(
       R"({"motion_distortion": true, "doppler": 0.049, "timestamp_offset": 0.03,
           "azimuth_offset": 0.0105, "range_offset": -0.3, "moving_objects": false,
-          "stamp_bursts": true, "my_effect": {"a": 1}})");
+          "stamp_bursts": true, "rotation_jitter": 0.01})");
   PhysicsConfig p = PhysicsConfig::fromJson(j);
   EXPECT_TRUE(p.motion_distortion);
   EXPECT_EQ(p.doppler, 0.049);
@@ -170,7 +170,7 @@ TEST(SimFormats, PhysicsRoundTripKeepsExtrasAndListsActiveEffects) {
   EXPECT_EQ(p.range_offset, -0.3);
   EXPECT_FALSE(p.moving_objects);
   std::vector<std::string> want{"motion_distortion", "doppler",      "timestamp_offset",
-                                "azimuth_offset",    "range_offset", "my_effect",
+                                "azimuth_offset",    "range_offset", "rotation_jitter",
                                 "stamp_bursts"};
   EXPECT_EQ(p.activeEffects(), want);
   std::string f = tmpFile("physics.json", "");
@@ -190,6 +190,11 @@ TEST(SimFormats, BadPhysicsNamesFileLineAndReason) {
   e = errorOf([&] { PhysicsConfig::load(p); });
   EXPECT_NE(e.find(p + ":2:"), std::string::npos) << e;
   EXPECT_NE(e.find("rotation_jitter"), std::string::npos) << e;
+  // A misspelt effect is an error, not an effect silently left out.
+  p = tmpFile("bad_physics3.json", "{\n \"dopler\": 0.049\n}\n");
+  e = errorOf([&] { PhysicsConfig::load(p); });
+  EXPECT_NE(e.find(p + ":2:"), std::string::npos) << e;
+  EXPECT_NE(e.find("dopler: unknown effect"), std::string::npos) << e;
 }
 
 TEST(SimFormats, SensorJsonRoundTripAndErrors) {

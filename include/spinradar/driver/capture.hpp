@@ -52,10 +52,14 @@ class CaptureReader {
   /// interrupted while writing) ends the replay; other corruption throws naming file and offset.
   bool next(Record& r);
   const std::string& path() const { return path_; }
+  /// After next() returned false: byte offset of the record the file cut short, -1 when the
+  /// file ended cleanly between records.
+  int64_t truncatedAt() const { return truncated_at_; }
 
  private:
   std::FILE* f_ = nullptr;
   std::string path_;
+  int64_t truncated_at_ = -1;
 };
 
 }  // namespace spinradar::navtech

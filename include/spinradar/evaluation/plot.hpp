@@ -72,5 +72,8 @@ std::vector<double> niceTicks(double lo, double hi, int target = 6);
 cv::Mat tile(const std::vector<cv::Mat>& panels, int cols);
 /// Writes a .png (8-bit, 1/3/4 channels) with an error naming the file.
 void saveImage(const cv::Mat& image, const std::string& path);
+/// Throws std::runtime_error naming `path` when it is not a .png file name (so a command can
+/// refuse `--plot x.txt` before doing any work).
+void checkImagePath(const std::string& path);
 
 }  // namespace spinradar::plot

@@ -33,13 +33,14 @@ struct PoseFile {
 /// Reads a CSV whose header names at least t, x, y, yaw (any order, extra columns ignored;
 /// vx, vy, wz read when present). Blank lines and lines starting with '#' are skipped. Throws
 /// std::runtime_error "<file>:<line>: <reason>" on a missing column, a non-number, a non-finite
-/// value, or a time that is not strictly increasing.
+/// value, a time that is not strictly increasing, or no data row after the header.
 PoseFile readPoseCsv(const std::string& path);
 /// Same, from a stream; `name` is used in error messages.
 PoseFile readPoseCsv(std::istream& in, const std::string& name);
 
-/// Writes `t,x,y,yaw,vx,vy,wz` (with_velocity) or `t,x,y,yaw`, full precision. Throws
-/// std::runtime_error naming the file when it cannot be written.
+/// Writes `t,x,y,yaw,vx,vy,wz` (with_velocity) or `t,x,y,yaw`, full precision, through a
+/// temporary file renamed when complete. Throws std::runtime_error naming the file when it
+/// cannot be written.
 void writePoseCsv(const std::string& path, const std::vector<PoseRecord>& poses,
                   bool with_velocity = true);
 void writePoseCsv(std::ostream& out, const std::vector<PoseRecord>& poses,
@@ -49,10 +50,12 @@ void writePoseCsv(std::ostream& out, const std::vector<PoseRecord>& poses,
 /// "t x y z qx qy qz qw" (z = 0, the yaw as a quaternion about z), full precision.
 void writeTumRow(std::ostream& out, const PoseRecord& p);
 
-/// Incremental writer (the odometry tool writes as it goes so a long run leaves a usable file).
+/// Incremental writer. Rows go to a temporary file next to `path` that close() renames onto it;
+/// destroyed without close() (a failed run) it leaves no partial file and `path` untouched.
+/// `live` (a node that runs until killed): rows go straight to `path`, flushed one by one.
 class PoseCsvWriter {
  public:
-  PoseCsvWriter(const std::string& path, bool with_velocity = true);
+  PoseCsvWriter(const std::string& path, bool with_velocity = true, bool live = false);
   ~PoseCsvWriter();
   void write(const PoseRecord& p);
   void close();
