@@ -1,6 +1,8 @@
 // PNG files without OpenCV's imgcodecs (see include/spinradar/io/png_io.hpp).
 #include "spinradar/io/png_io.hpp"
 
+#include "spinradar/core/safe_output.hpp"
+
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -110,20 +112,15 @@ void writePng(const cv::Mat& image, const std::string& path, int level) {
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(path + ": cannot write PNG (" + e.what() + ")");
   }
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw std::runtime_error(path + ": cannot write PNG (cannot create the file)");
-  const bool written = std::fwrite(png.data(), 1, png.size(), f) == png.size();
-  const bool closed = std::fclose(f) == 0;
-  std::error_code ec;
-  if (!written || !closed) {
-    std::filesystem::remove(tmp, ec);
-    throw std::runtime_error(path + ": cannot write PNG (write failed)");
-  }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw std::runtime_error(path + ": cannot write PNG (" + ec.message() + ")");
+  // The one temp-file-and-rename helper (core/safe_output.hpp): no half-written PNG is left.
+  try {
+    AtomicOutputFile file(path);
+    file.stream().write(reinterpret_cast<const char*>(png.data()), std::streamsize(png.size()));
+    file.commit();
+  } catch (const std::runtime_error& e) {
+    std::string why = e.what();
+    if (why.rfind(path + ": ", 0) == 0) why = why.substr(path.size() + 2);
+    throw std::runtime_error(path + ": cannot write PNG (" + why + ")");
   }
 }
 
