@@ -214,7 +214,40 @@ void resimulateWithEffects(const DiagnoseInput& in, const DiagnoseOptions& opt,
         << t.after.position_rms << " m); not reported as an effect.";
       rep.notes.push_back(n.str());
     }
-    rep.effects = kept;
+    rep.effects.clear();
+    for (const EffectResult& r : kept) {
+      // Practical significance: an effect under half a bin (or row) that lowers the re-simulated
+      // residual by under 5 % is negligible, whatever its z (kept in the fitted physics).
+      const double drop = r.residual_rms_before > 0
+                              ? 1.0 - r.residual_rms_after / r.residual_rms_before : 0.0;
+      double size = -1;  // in bins or rows; -1 = no resolution scale for this effect
+      std::string unit;
+      if (r.effect == Effect::RangeOffset) {
+        size = std::fabs(r.change) / in.sensor.range_resolution, unit = "bins";
+      } else if (r.effect == Effect::AzimuthOffset) {
+        size = std::fabs(r.change) * in.sensor.azimuths / (2 * M_PI), unit = "rows";
+      } else if (r.effect == Effect::TimestampOffset) {
+        size = std::fabs(r.change) * in.sensor.rotation_hz * in.sensor.azimuths, unit = "rows of time";
+        const double half = 0.5 / in.sensor.rotation_hz;
+        if (!in.base.motion_distortion && std::fabs(std::fabs(r.change) - half) < 0.1 * half) {
+          std::ostringstream n;
+          n << "The fitted timestamp offset (" << r.change << " s) is half a rotation on a model "
+            << "without motion distortion: it is the scan-pose-time convention (the pose of a scan "
+            << "taken at its first azimuth vs mid-sweep; physics \"scan_pose_time\"), not a latency.";
+          rep.notes.push_back(n.str());
+        }
+      }
+      if (size >= 0 && size < 0.5 && drop < 0.05) {
+        std::ostringstream n;
+        n << r.name << " = " << r.value << " +- " << r.stddev << " " << r.unit << " (z "
+          << r.significance << ") is negligible: " << size << " " << unit << ", residual "
+          << r.residual_rms_before << " -> " << r.residual_rms_after << " m (" << 100 * drop
+          << " % drop); statistically significant, practically nothing.";
+        rep.notes.push_back(n.str());
+        continue;
+      }
+      rep.effects.push_back(r);
+    }
     rep.fitted = confirmed;
     rep.mismatch_found = !rep.effects.empty();
     if (!rep.after_step.empty()) {

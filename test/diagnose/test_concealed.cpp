@@ -106,3 +106,17 @@ INSTANTIATE_TEST_SUITE_P(Diagnose, Concealed, ::testing::Values(
 // clang-format on
 
 }  // namespace
+
+// Practical significance: an effect is negligible only when it is under half a bin (row) AND
+// buys under 5 % residual drop. A third of a bin (1.4 cm) that removes most of the residual
+// (weak, noisy peaks; rms 2.7 -> 0.8 cm) is still a mismatch and must not be filtered out.
+TEST(PracticalSignificance, ThirdOfABinRangeOffsetThatLowersTheResidualIsNamed) {
+  const sim::World world = randomWorld(61, 90, 55.0, false);
+  DiagnoseInput in = makeInput(world, walking(), sim::PhysicsConfig::fromJson({{"range_offset", 0.014}}),
+                               6, 61, noisySensor());
+  const DiagnoseReport rep = spinradar::diagnose::diagnose(in, DiagnoseOptions{});
+  ASSERT_EQ(rep.effects.size(), 1u);
+  EXPECT_EQ(rep.effects.front().name, "range_offset");
+  EXPECT_NEAR(rep.effects.front().value, 0.014, 0.0014);
+  EXPECT_LT(rep.effects.front().residual_rms_after, 0.95 * rep.effects.front().residual_rms_before);
+}
