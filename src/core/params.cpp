@@ -21,7 +21,8 @@ void FeatureConfig::validate() const {
 
 void EstimatorConfig::validate() const {
   checkParamRanges(*this, "estimator");
-  checkOneOf(estimator, {"rigid", "mc", "mc_doppler", "refined", "keyframe"}, "estimator");
+  checkOneOf(estimator, {"rigid", "mc", "mc_doppler", "refined", "keyframe", "surface"}, "estimator");
+  checkOneOf(azimuth_times, {"stamps", "uniform"}, "azimuth_times");
 }
 
 }  // namespace spinradar

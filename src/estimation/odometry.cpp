@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "spinradar/estimation/azimuth_times.hpp"
 #include "spinradar/estimation/doppler.hpp"
 #include "spinradar/features/feature_extractor.hpp"
 #include "spinradar/estimation/keyframe_tracker.hpp"
@@ -14,13 +15,14 @@
 #include "spinradar/estimation/mc_ransac.hpp"
 #include "spinradar/estimation/refined_estimator.hpp"
 #include "spinradar/estimation/rigid_ransac.hpp"
+#include "spinradar/estimation/surface_tracker.hpp"
 #include "spinradar/estimation/undistort.hpp"
 
 namespace spinradar {
 
 namespace {
 
-enum class Estimator { kRigid, kMc, kMcDoppler, kRefined, kKeyframe };
+enum class Estimator { kRigid, kMc, kMcDoppler, kRefined, kKeyframe, kSurface };
 
 Estimator parseEstimator(const std::string& name) {
   if (name == "rigid") return Estimator::kRigid;
@@ -28,6 +30,7 @@ Estimator parseEstimator(const std::string& name) {
   if (name == "mc_doppler") return Estimator::kMcDoppler;
   if (name == "refined") return Estimator::kRefined;
   if (name == "keyframe") return Estimator::kKeyframe;
+  if (name == "surface") return Estimator::kSurface;
   throw std::invalid_argument("parameter 'estimator': unknown value '" + name + "'");
 }
 
@@ -67,6 +70,9 @@ struct Odometry::Impl {
   McRansac mc;
   RefinedEstimator refined;
   KeyframeTracker keyframe;  ///< on top of refined for the keyframe estimator
+  SurfaceTracker surface;    ///< on top of keyframe for the surface estimator
+  /// surface: the keyframe tracker's own chain (its steps are the surface stage's prediction)
+  Eigen::Matrix3d T_kf = Eigen::Matrix3d::Identity(), P_kf = Eigen::Matrix3d::Zero();
 
   FrameBuffer prev, cur;
   bool has_prev = false;
@@ -86,12 +92,18 @@ struct Odometry::Impl {
     const bool features_changed = extractor && !sameFeatureConfig(config, c);
     config = c;
     const Estimator next = parseEstimator(c.estimator.estimator);
-    if (next != estimator) keyframe.reset();  // its keyframe chain is stale after a switch
+    if (next != estimator) {  // keyframe chains are stale after a switch
+      keyframe.reset();
+      surface.reset();
+      T_kf = T_world;
+      P_kf = pose_cov;
+    }
     estimator = next;
     rigid.setConfig(c.estimator);
     mc.setConfig(c.estimator);
     refined.setConfig(c.estimator);
     keyframe.setConfig(c.estimator);
+    surface.setConfig(c.estimator);
     if (features_changed) extractor.reset();  // rebuilt with the new settings on demand
   }
 
@@ -120,6 +132,9 @@ struct Odometry::Impl {
     pose_cov.setZero();
     refined.reset();
     keyframe.reset();
+    surface.reset();
+    T_kf.setIdentity();
+    P_kf.setZero();
     corrected.clear();
     raw.clear();
   }
@@ -137,6 +152,7 @@ struct Odometry::Impl {
                                  config.estimator.beta, corr1, corr2, m);
       case Estimator::kRefined:
       case Estimator::kKeyframe:
+      case Estimator::kSurface:
         return refined.estimate(a, b, matches, corr1, corr2, m);
     }
     return false;
@@ -169,13 +185,20 @@ struct Odometry::Impl {
         res.T_keyframe_sensor = keyframe.relativePose();
         res.keyframe_cov = keyframe.relativeCov();
         dopplerCorrect(cur.frame.keypoints, m.velocity, config.estimator.beta, corr2);
+      } else if (ok && estimator == Estimator::kSurface) {
+        trackSurface(m, 1e-9 * static_cast<double>(cur.frame.stamp_ns - prev.frame.stamp_ns));
+        res.keyframe_stamp_ns = surface.keyframeStamp();
+        res.T_keyframe_sensor = surface.relativePose();
+        res.keyframe_cov = surface.relativeCov();
+        dopplerCorrect(cur.frame.keypoints, m.velocity, config.estimator.beta, corr2);
       } else if (!ok) {
         keyframe.reset();  // the prediction below is not tied to the keyframe
       }
       times.estimate_ms = msSince(t0);
       const double dt_ref = 1e-9 * static_cast<double>(cur.frame.stamp_ns - prev.frame.stamp_ns);
       if (ok) {
-        if (estimator == Estimator::kRefined || estimator == Estimator::kKeyframe) {
+        if (estimator == Estimator::kRefined || estimator == Estimator::kKeyframe ||
+            estimator == Estimator::kSurface) {
           // Published covariance (NEES on the city route): the refined step and velocity
           // assume a constant velocity over the pair; add what acceleration over the step
           // leaves out, the same model the keyframe estimator puts on this step as its prior.
@@ -188,12 +211,13 @@ struct Odometry::Impl {
               Eigen::Vector3d(KeyframeTracker::kStepAccelSigma * h, KeyframeTracker::kStepAccelSigma * h,
                               KeyframeTracker::kStepAngAccelSigma * h).cwiseAbs2();
         }
-        if (estimator != Estimator::kKeyframe) compound(m.T_12, m.T_12_cov);
+        if (estimator != Estimator::kKeyframe && estimator != Estimator::kSurface)
+          compound(m.T_12, m.T_12_cov);
         last = m;
         has_last = true;
         res.ok = true;
         doppler = estimator == Estimator::kMcDoppler || estimator == Estimator::kRefined ||
-                  estimator == Estimator::kKeyframe;
+                  estimator == Estimator::kKeyframe || estimator == Estimator::kSurface;
       } else if (has_last && dt_ref > 0.0) {
         // Estimation failed (too few matches, degenerate geometry): predict with the last
         // velocity so the trajectory stays continuous; res.ok = false reports the failure.
@@ -204,6 +228,7 @@ struct Odometry::Impl {
         m.inliers.clear();
         setMotionFromVelocity(last.velocity, last.velocity_cov, dt_ref, m);
         compound(m.T_12, m.T_12_cov);
+        T_kf = T_kf * m.T_12;
       }
       velocity = m.velocity;
       have_velocity = ok || (has_last && dt_ref > 0.0);
@@ -222,6 +247,23 @@ struct Odometry::Impl {
     std::swap(prev, cur);
     has_prev = true;
     return res;
+  }
+
+  /// surface: the keyframe estimator on its own chain gives the predicted step (m.T_12 on
+  /// entry: the refined pair's), the surface stage registers the scan; m.T_12 becomes the
+  /// step taken. dt: scan period.
+  void trackSurface(MotionEstimate& m, double dt) {
+    Eigen::Matrix3d T_k, P_k;
+    keyframe.track(cur.frame, T_kf, P_kf, config.features.nndr, m, T_k, P_k);
+    T_kf = T_k;
+    P_kf = P_k;
+    // The refined pair's covariance (+ what acceleration leaves out) bounds the step's.
+    Eigen::Matrix3d C = m.T_12_cov;
+    C.diagonal() += KeyframeTracker::stepModelNoise(dt);
+    Eigen::Matrix3d T_new, P_new;
+    surface.track(cur.frame, m.velocity, T_world, pose_cov, m.T_12, C, T_new, P_new);
+    m.T_12 = se2::inverse(T_world) * T_new;
+    setPose(T_new, P_new);
   }
 
   /// T_world <- T_world T_12 with first-order propagation over [x, y, yaw] (se2::compoundXyYaw):
@@ -252,6 +294,7 @@ OdometryResult Odometry::process(const PolarScan& scan) {
     d.extractor = std::make_unique<FeatureExtractor>(d.config.detector, d.config.features);
   StageTimes times;
   d.extractor->extract(scan, d.cur.frame, &times);
+  if (d.config.estimator.azimuth_times == "uniform") uniformKeypointTimes(scan, d.cur.frame.keypoints);
   return d.step(times);
 }
 

@@ -35,7 +35,10 @@ TEST(KeyframeAllocations, NoneAfterWarmUp) {
   // Odometry::process returns an OdometryResult by value (its inlier vector allocates):
   // the keyframe estimator (matching against the keyframe, registration, new keyframes)
   // must not add any allocation to what refined needs.
-  const long refined = perScan("refined"), keyframe = perScan("keyframe");
-  std::cout << "[ info ] allocations over 8 scans: refined " << refined << ", keyframe " << keyframe << "\n";
+  const long refined = perScan("refined"), keyframe = perScan("keyframe"),
+             surface = perScan("surface");
+  std::cout << "[ info ] allocations over 8 scans: refined " << refined << ", keyframe " << keyframe
+            << ", surface " << surface << "\n";
   EXPECT_LE(keyframe, refined);
+  EXPECT_LE(surface, refined);  // surface points, submap and its index reuse their buffers
 }

@@ -27,14 +27,15 @@
   X(int, max_keypoints, 0, 0, 100000, "", "Keep at most this many strongest keypoints (0 = all)")
 
 #define SPINRADAR_ESTIMATOR_PARAMS(X) \
-  X(std::string, estimator, "keyframe", 0, 0, "", "Motion estimator: rigid, mc, mc_doppler, refined or keyframe") \
+  X(std::string, estimator, "keyframe", 0, 0, "", "Motion estimator: rigid, mc, mc_doppler, refined, keyframe or surface") \
   X(int, ransac_iterations, 100, 1, 10000, "", "RANSAC iterations") \
   X(double, inlier_threshold, 0.35, 0.01, 5.0, "m", "RANSAC inlier threshold") \
   X(int, ransac_seed, 7, 0, 1000000, "", "RANSAC random seed (fixed for reproducibility)") \
   X(int, gn_iterations, 10, 1, 100, "", "Gauss-Newton iterations of MC-RANSAC refits") \
   X(double, beta, 0.049, 0.0, 1.0, "s", "Doppler coefficient beta = f_t / (df/dt)") \
   X(double, range_sigma, 0.0438, 0.001, 1.0, "m", "Range noise std for Cartesian covariance weighting") \
-  X(double, azimuth_sigma, 0.0045, 0.0001, 0.1, "rad", "Azimuth noise std for Cartesian covariance weighting")
+  X(double, azimuth_sigma, 0.0045, 0.0001, 0.1, "rad", "Azimuth noise std for Cartesian covariance weighting") \
+  X(std::string, azimuth_times, "stamps", 0, 0, "", "Keypoint times: stamps (each row's recorded stamp) or uniform (a line fitted to the scan's row stamps: for stamps that are packet arrival times, as in Oxford and MulRan)")
 // clang-format on
 
 namespace spinradar {

@@ -1,0 +1,202 @@
+#!/usr/bin/env bash
+# The evaluation matrix the default estimator is chosen from (issue 19): rows are estimators
+# and front-end options, columns are data sets. One markdown table of KITTI drift
+# (% / deg/m, 100..800 m subsequences) per simulated column and, for the real Oxford sample
+# (../shared/realdata, 2 consecutive-scan pairs with the dataset's ground truth), the mean
+# per-pair yaw error (deg) / translation error (%). Held-out columns (not looked at while
+# tuning) are printed in a second table.
+#
+# Simulated columns: the built-in scenes with full physics (motion distortion, Doppler
+# beta 0.049 s, moving cars) under several sensor models (--sensor JSON subsets of
+# include/spinradar/sim/sensor_config.hpp): range PSF wide (today's 2.7 bins sigma in power)
+# and narrow (0.64 bins: 1.5 bins FWHM), beam width 1.5 / 2.4 deg (default 1.8), a higher
+# noise floor, 4x the ground-clutter density (the world file's weak clutter scatterers
+# replicated with jitter, then simulated with --world), plus every calibrated sensor model
+# in config/sensors/*.json when there is one.
+#
+# Usage: scripts/evaluation_matrix.sh [OUT_DIR]      (default build/evaluation_matrix)
+# Env: SPINRADAR_BIN (CLI), SCANS (scans per simulated column, default 480 = 2 min),
+#      THREADS (default 2), COLS / ROWS (space-separated labels to restrict to), SEED (1),
+#      STEP (devkit first-frame step, default 4), SHARED (default ../shared next to the repo),
+#      MERGE (further results.tsv files, e.g. of a run on other COLS, to print in the tables).
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+out="${1:-$root/build/evaluation_matrix}"
+scans="${SCANS:-480}"
+threads="${THREADS:-2}"
+seed="${SEED:-1}"
+step="${STEP:-4}"
+shared="${SHARED:-$root/../shared}"
+[[ -d "$shared/realdata" ]] || shared="/work/shared"
+
+source "$root/scripts/cli_path.sh"
+bin="$(spinradar_cli_path "$root")"
+[[ -n "$bin" && -x "$bin" ]] || { echo "error: spinradar CLI not found (build first or set SPINRADAR_BIN)" >&2; exit 1; }
+mkdir -p "$out"
+
+# --- rows: label = odometry options -------------------------------------------------------
+declare -A row_args=(
+  [rigid]="--estimator rigid"
+  [mc]="--estimator mc"
+  [mc_doppler]="--estimator mc_doppler"
+  [refined]="--estimator refined"
+  [keyframe]="--estimator keyframe"
+  [keyframe+peaks]="--estimator keyframe --azimuth_peaks true"
+  [surface]="--estimator surface"
+  [surface+peaks]="--estimator surface --azimuth_peaks true"
+)
+all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks surface surface+peaks)
+# Rows whose estimator this CLI does not know are left out (older builds).
+rows=()
+for r in ${ROWS:-${all_rows[@]}}; do
+  [[ -n "${row_args[$r]:-}" ]] || { echo "error: unknown row '$r' (rows: ${all_rows[*]})" >&2; exit 1; }
+  est="$(sed -n 's/.*--estimator \([a-z_]*\).*/\1/p' <<< "${row_args[$r]}")"
+  if "$bin" params 2>/dev/null | grep -q "^| *estimator" && ! "$bin" params 2>/dev/null | grep "^| *estimator" | grep -q "$est"; then
+    echo "note: row $r skipped (this build has no estimator '$est')" >&2; continue
+  fi
+  rows+=("$r")
+done
+
+# --- columns: label | scene | variant | sensor JSON | clutter factor | held out ------------
+cols_spec=(
+  "city_wide|city|0|{}|1|no"
+  "city_narrow|city|0|{\"range_psf_sigma_bins\": 0.64}|1|no"
+  "city_beam1.5|city|0|{\"beam_width_deg\": 1.5}|1|no"
+  "city_beam2.4|city|0|{\"beam_width_deg\": 2.4}|1|no"
+  "city_noise14|city|0|{\"noise_floor_db\": 14.0}|1|no"
+  "city_clutter4x|city|0|{}|4|no"
+  "tight_turns|tight_turns|0|{}|1|no"
+  "city_v5_narrow_beam2.4|city|5|{\"range_psf_sigma_bins\": 0.64, \"beam_width_deg\": 2.4}|1|yes"
+  "out_and_back|out_and_back|0|{}|1|yes"
+)
+for f in "$root"/config/sensors/*.json; do
+  [[ -f "$f" ]] || continue
+  cols_spec+=("city_$(basename "$f" .json)|city|0|$(tr -d '\n' < "$f")|1|no")
+done
+cols_spec+=("oxford_real|-|-|-|-|no")
+
+cat > "$out/physics_full.json" <<'EOF'
+{"motion_distortion": true, "doppler": 0.049, "moving_objects": true}
+EOF
+
+# 4x clutter: every weak static point scatterer (rcs < -28 dBsm: the scene's ground clutter;
+# trees are -30..-18) gets factor-1 jittered copies with fresh reflectivities.
+multiply_clutter() {  # world_in world_out factor seed
+  /usr/bin/env python3 - "$@" <<'PY'
+import json, random, sys
+src, dst, factor, seed = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
+w = json.load(open(src))
+rng = random.Random(seed)
+extra = []
+for t in w["targets"]:
+    if t.get("rcs", 10) < -28 and not t.get("vx") and not t.get("vy"):
+        for _ in range(factor - 1):
+            extra.append({"x": t["x"] + rng.uniform(-2, 2), "y": t["y"] + rng.uniform(-2, 2),
+                          "rcs": -40.0 + 7.0 * rng.gauss(0, 1)})
+w["targets"] += extra
+json.dump(w, open(dst + ".tmp", "w"))
+import os; os.replace(dst + ".tmp", dst)
+print(f"clutter x{factor}: {len(extra)} scatterers added", file=sys.stderr)
+PY
+}
+
+simulate_column() {  # label scene variant sensor clutter
+  local label="$1" scene="$2" variant="$3" sensor="$4" clutter="$5"
+  local rec="$out/rec_$label"
+  local stamp="scene=$scene variant=$variant seed=$seed scans=$scans clutter=$clutter sensor=$sensor physics=$(tr -d ' \n' < "$out/physics_full.json")"
+  if [[ -f "$rec/.spinradar_matrix" && "$(cat "$rec/.spinradar_matrix")" == "$stamp" ]]; then return; fi
+  rm -rf "$rec"
+  echo "$sensor" > "$out/sensor_$label.json"
+  local args=(simulate --physics "$out/physics_full.json" --sensor "$out/sensor_$label.json"
+              --seed "$seed" --scans "$scans" --out "$rec")
+  if [[ "$clutter" != 1 ]]; then
+    # The built-in scene's world and route, written once, then the clutter multiplied.
+    local base="$out/base_${scene}_$variant"
+    if [[ ! -f "$base/world.json" ]]; then
+      "$bin" simulate --scene "$scene" --variant "$variant" --scans 1 --out "$base" 2> /dev/null
+    fi
+    multiply_clutter "$base/world.json" "$out/world_$label.json" "$clutter" "$((variant + 11))"
+    args+=(--world "$out/world_$label.json" --trajectory "$base/trajectory.csv")
+  else
+    args+=(--scene "$scene" --variant "$variant")
+  fi
+  echo "== simulating $label ($scans scans)" >&2
+  "$bin" "${args[@]}" 2> "$out/simulate_$label.log"
+  echo "$stamp" > "$rec/.spinradar_matrix"
+}
+
+results="$out/results.tsv"
+: > "$results"
+for spec in "${cols_spec[@]}"; do
+  IFS='|' read -r label scene variant sensor clutter held <<< "$spec"
+  if [[ -n "${COLS:-}" && " $COLS " != *" $label "* ]]; then continue; fi
+  if [[ "$scene" == "-" ]]; then
+    seq="$shared/realdata/oxford_2019-01-10-14-36-48"
+    [[ -d "$seq/radar" ]] || { echo "note: $seq absent, Oxford column skipped" >&2; continue; }
+    for r in "${rows[@]}"; do
+      e="$out/${label}__$r"
+      # shellcheck disable=SC2086
+      "$bin" odometry --input "$seq" --out "$e.csv" --quiet --threads "$threads" ${row_args[$r]} 2> "$e.log"
+      "$bin" eval --est "$e.csv" --gt "$seq/gt/radar_odometry.csv" --json "$e.json" > /dev/null
+      printf '%s\t%s\t%s\t%s\n' "$label" "$r" "$held" "$e.json" >> "$results"
+    done
+    continue
+  fi
+  simulate_column "$label" "$scene" "$variant" "$sensor" "$clutter"
+  rec="$out/rec_$label"
+  for r in "${rows[@]}"; do
+    e="$out/${label}__$r"
+    echo "== $label: $r" >&2
+    # shellcheck disable=SC2086
+    "$bin" odometry --input "$rec" --out "$e.csv" --quiet --threads "$threads" ${row_args[$r]} 2> "$e.log"
+    "$bin" eval --est "$e.csv" --gt "$rec/trajectory.csv" --step "$step" --json "$e.json" > /dev/null
+    printf '%s\t%s\t%s\t%s\n' "$label" "$r" "$held" "$e.json" >> "$results"
+  done
+done
+
+/usr/bin/env python3 - "$scans" "$results" ${MERGE:-} <<'PY'
+import json, math, sys
+rows, cols, held, cell = [], [], {}, {}
+lines = [l for f in sys.argv[2:] for l in open(f)]
+for line in lines:
+    c, r, h, path = line.rstrip("\n").split("\t")
+    if c not in cols: cols.append(c)
+    if r not in rows: rows.append(r)
+    held[c] = h == "yes"
+    j = json.load(open(path))[0]
+    if c == "oxford_real":
+        fr = j["frames"]
+        if not fr: cell[c, r] = None; continue
+        yaw = sum(math.degrees(f["r_err_rad"]) for f in fr) / len(fr)
+        t = sum(f["t_err_pct"] for f in fr) / len(fr)
+        cell[c, r] = (yaw, t, j.get("path_length_m", 0.0), len(fr))
+    else:
+        cell[c, r] = (j["t_err_pct"], j["r_err_deg_per_m"], j["path_length_m"], j["poses"]) if j["drift_valid"] else None
+# ms per scan of the chain (odometry log "total" line) is not parsed: see `spinradar bench`.
+def table(sel, title):
+    if not sel: return
+    print(f"\n{title}\n")
+    print("| estimator | " + " | ".join(sel) + " |")
+    print("|---|" + "---|" * len(sel))
+    best = {}
+    for c in sel:
+        v = [cell[c, r][0] for r in rows if cell.get((c, r))]
+        best[c] = min(v) if v else None
+    for r in rows:
+        out = []
+        for c in sel:
+            x = cell.get((c, r))
+            if not x: out.append("n/a"); continue
+            s = f"{x[0]:.3f} / {x[1]:.4f}" if c == "oxford_real" else f"{x[0]:.2f} / {x[1]:.4f}"
+            if best[c] is not None and x[0] <= 1.05 * best[c]: s = f"**{s}**"
+            out.append(s)
+        print(f"| {r} | " + " | ".join(out) + " |")
+    lens = []
+    for c in sel:
+        x = next((cell[c, r] for r in rows if cell.get((c, r))), None)
+        if x: lens.append(f"{c}: {x[2]:.0f} m, {x[3]} {'pairs' if c == 'oxford_real' else 'scans'}")
+    print("\n" + "; ".join(lens))
+tuned = [c for c in cols if not held[c]]
+table(tuned, "Columns used while tuning (simulated: KITTI drift % / deg/m; oxford_real: mean yaw error deg / translation error % per pair; bold: within 5 % of the column's best)")
+table([c for c in cols if held[c]], "Held-out columns (not looked at while tuning)")
+PY
