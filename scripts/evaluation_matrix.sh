@@ -176,8 +176,8 @@ for line in lines:
 def table(sel, title):
     if not sel: return
     print(f"\n{title}\n")
-    print("| estimator | " + " | ".join(sel) + " |")
-    print("|---|" + "---|" * len(sel))
+    print("| estimator | " + " | ".join(sel) + " | worst ratio to the column's best |")
+    print("|---|" + "---|" * (len(sel) + 1))
     best = {}
     for c in sel:
         v = [cell[c, r][0] for r in rows if cell.get((c, r))]
@@ -190,7 +190,10 @@ def table(sel, title):
             s = f"{x[0]:.3f} / {x[1]:.4f}" if c == "oxford_real" else f"{x[0]:.2f} / {x[1]:.4f}"
             if best[c] is not None and x[0] <= 1.05 * best[c]: s = f"**{s}**"
             out.append(s)
-        print(f"| {r} | " + " | ".join(out) + " |")
+        # The default is chosen by this: its worst ratio over the columns (first figure).
+        ratios = [cell[c, r][0] / best[c] for c in sel if cell.get((c, r)) and best[c]]
+        worst = f"{max(ratios):.2f}" if len(ratios) == len(sel) else "n/a"
+        print(f"| {r} | " + " | ".join(out) + f" | {worst} |")
     lens = []
     for c in sel:
         x = next((cell[c, r] for r in rows if cell.get((c, r))), None)

@@ -2,7 +2,9 @@
 // Frame-to-frame radar odometry: features of each scan are matched to the previous scan,
 // a motion estimator (rigid, mc, mc_doppler, refined, keyframe) gives the body velocity, and the
 // results are compounded into a pose. The keyframe estimator instead registers each scan to
-// a keyframe with the refined step as prior (keyframe_tracker.hpp) and sets the pose. Pose convention: SE(2) 3x3 matrices, T_ab = pose of
+// a keyframe with the refined step as prior (keyframe_tracker.hpp) and sets the pose; the
+// surface estimator registers each scan's oriented surface points to a submap with the
+// keyframe estimator's step as prior (surface_tracker.hpp). Pose convention: SE(2) 3x3 matrices, T_ab = pose of
 // frame b expressed in frame a; REP 103 (x forward, y left, yaw CCW).
 #include <memory>
 #include <vector>
