@@ -18,7 +18,8 @@
 # Env: SPINRADAR_BIN (CLI), SCANS (scans per simulated column, default 480 = 2 min),
 #      THREADS (default 2), COLS / ROWS (space-separated labels to restrict to), SEED (1),
 #      STEP (devkit first-frame step, default 4), SHARED (default ../shared next to the repo),
-#      MERGE (further results.tsv files, e.g. of a run on other COLS, to print in the tables).
+#      MERGE (further results.tsv files, e.g. of a run on other COLS, to print in the tables),
+#      TABLE_ONLY=1 (print the tables of OUT_DIR/results.tsv and MERGE, run nothing).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="${1:-$root/build/evaluation_matrix}"
@@ -126,7 +127,9 @@ simulate_column() {  # label scene variant sensor clutter
 }
 
 results="$out/results.tsv"
-: > "$results"
+# TABLE_ONLY=1: print the tables of an earlier run (and MERGE) without running anything.
+[[ -n "${TABLE_ONLY:-}" ]] && cols_spec=()
+[[ -n "${TABLE_ONLY:-}" ]] || : > "$results"
 for spec in "${cols_spec[@]}"; do
   IFS='|' read -r label scene variant sensor clutter held <<< "$spec"
   if [[ -n "${COLS:-}" && " $COLS " != *" $label "* ]]; then continue; fi
