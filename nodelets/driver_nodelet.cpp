@@ -1,7 +1,8 @@
 // Navtech driver nodelet: a shell around spinradar::navtech::NavtechDriver. A poll thread
 // (started in onInit, joined in the destructor) publishes one spinradar/RadarScan per rotation
 // on `scan`, optionally the Oxford-layout mono8 image on `polar_image`, and diagnostics (scan
-// rate, dropped azimuths and scans, reconnects, stream errors) on /diagnostics.
+// rate, dropped azimuths and scans, reconnects, stream errors, time anomalies) on /diagnostics,
+// at a level that reflects the last few seconds (navtech::DriverHealth).
 #include <atomic>
 #include <memory>
 #include <thread>
@@ -13,6 +14,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 
+#include "spinradar/driver/driver_health.hpp"
 #include "spinradar/driver/navtech_driver.hpp"
 #include "spinradar/sim/sim_radar_input.hpp"
 #include "spinradar_ros/params.hpp"
@@ -104,18 +106,18 @@ class DriverNodelet : public nodelet::Nodelet {
 
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& s) {
     const DriverStats st = driver_->stats();
-    const uint64_t problems = st.dropped_scans + st.missing_azimuths + st.duplicated_azimuths;
-    if (!driver_->hasConfiguration())
-      s.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no sensor configuration (not connected?)");
-    else if (problems > last_problems_ || st.input.disconnects > last_disconnects_)
-      s.summary(diagnostic_msgs::DiagnosticStatus::WARN, "dropped data or reconnects since last report");
-    else
-      s.summary(diagnostic_msgs::DiagnosticStatus::OK, "streaming");
-    last_problems_ = problems;
-    last_disconnects_ = st.input.disconnects;
+    const int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                            std::chrono::steady_clock::now().time_since_epoch()).count();
+    const Health h = health_.update(st, driver_->hasConfiguration(), now);
+    using diagnostic_msgs::DiagnosticStatus;
+    s.summary(h.level == HealthLevel::Error  ? DiagnosticStatus::ERROR
+              : h.level == HealthLevel::Warn ? DiagnosticStatus::WARN
+                                             : DiagnosticStatus::OK,
+              h.message);
     s.add("scans", st.scans);
     s.add("azimuths", st.azimuths);
     s.add("dropped scans", st.dropped_scans);
+    s.add("partial rotations at connect", st.partial_scans);
     s.add("missing azimuths", st.missing_azimuths);
     s.add("duplicated azimuths", st.duplicated_azimuths);
     s.add("connects", st.input.connects);
@@ -126,6 +128,9 @@ class DriverNodelet : public nodelet::Nodelet {
     s.add("oversized headers", st.input.stream.oversized);
     s.add("truncated messages", st.input.stream.truncated);
     s.add("malformed messages", st.input.malformed);
+    s.add("unknown message types", st.input.unknown_types);
+    s.add("time anomalies", st.time_anomalies);
+    s.add("last time anomaly", st.last_time_anomaly.empty() ? "none" : st.last_time_anomaly);
     s.add("implausible sensor times", st.implausible_times);
     s.add("time byte order", st.byte_order == TimeByteOrder::Big ? "big" : "little");
     s.add("time source", config_.time_source);
@@ -138,7 +143,7 @@ class DriverNodelet : public nodelet::Nodelet {
   std::unique_ptr<diagnostic_updater::Updater> updater_;
   std::unique_ptr<diagnostic_updater::FrequencyStatus> rate_;
   double min_hz_ = 3.6, max_hz_ = 4.4;
-  uint64_t last_problems_ = 0, last_disconnects_ = 0;
+  DriverHealth health_;
   std::atomic<bool> running_{false};
   std::thread thread_;
 };

@@ -1,7 +1,8 @@
 // Estimator nodelet: spinradar/Features in (`features`); frame-to-frame radar odometry out:
 // nav_msgs/Odometry `odom`, TwistStamped `velocity`, tf odom -> base, PointCloud2
 // `points_corrected` (undistorted to the scan time, Doppler-corrected) and `points_raw`, and a
-// nav_msgs/Path `path` for rviz. The radar mounting T_base_radar comes from tf.
+// nav_msgs/Path `path` for rviz. The radar mounting T_base_radar comes from tf. Time going back
+// or a long gap between scans starts a new segment (warning; pose and tf stay continuous).
 #include <memory>
 #include <mutex>
 
@@ -75,7 +76,16 @@ class EstimatorNodelet : public nodelet::Nodelet {
       return;
     }
     const spinradar::OdometryResult result = odometry_->process(frame_);
-    if (!result.ok && scans_ > 0)
+    using TimeEvent = spinradar::OdometryResult::TimeEvent;
+    if (result.time_event == TimeEvent::Backwards)
+      NODELET_WARN("scan at %.3f: time went back by %.3f s: odometry state reset, pose kept "
+                   "(covariance inflated); velocity re-estimated from the next scan",
+                   msg->header.stamp.toSec(), -result.time_step_s);
+    else if (result.time_event == TimeEvent::Gap)
+      NODELET_WARN("scan at %.3f: %.3f s since the previous scan: new segment, no step "
+                   "extrapolated across the gap (covariance inflated); velocity re-estimated "
+                   "from the next scan", msg->header.stamp.toSec(), result.time_step_s);
+    else if (!result.ok && scans_ > 0)
       NODELET_WARN("scan at %.3f: motion estimation failed (%d matches); pose extrapolated",
                    msg->header.stamp.toSec(), result.motion.matches);
     ++scans_;

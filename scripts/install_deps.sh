@@ -13,6 +13,7 @@ PKGS=(
   libdiagnostic-updater-dev libcv-bridge-dev
   rosbash tf2-tools python3-tf2-ros python3-sensor-msgs python3-nodelet
   rviz xvfb xauth libgl1-mesa-dri imagemagick
+  python3-numpy python3-opencv python3-matplotlib
 )
 missing=()
 for p in "${PKGS[@]}"; do

@@ -24,3 +24,12 @@ if(TARGET spinradar_nodelets AND CATKIN_ENABLE_TESTING)
       spinradar_cli)
   endif()
 endif()
+
+# Navtech's own Python SDK example (../shared/navtech-iasdk) reads a full rotation from
+# `spinradar serve`; skipped with a message when ../shared is absent.
+if(TARGET spinradar_cli)
+  add_test(NAME driver_navtech_sdk_example
+    COMMAND bash ${PROJECT_SOURCE_DIR}/test/driver/navtech_sdk_example.sh
+            $<TARGET_FILE:spinradar_cli> ${SPINRADAR_SHARED_DIR} ${CMAKE_BINARY_DIR}/test_navtech_sdk)
+  set_tests_properties(driver_navtech_sdk_example PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 180)
+endif()

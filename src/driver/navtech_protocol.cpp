@@ -81,9 +81,9 @@ void encodeFftHead(std::vector<uint8_t>& out, MsgType type, size_t bin_bytes, ui
 
 }  // namespace
 
-bool decodeHeader(const uint8_t* p, uint8_t& type, uint32_t& payload_size) {
+bool decodeHeader(const uint8_t* p, uint8_t& type, uint32_t& payload_size, uint8_t* version) {
   if (std::memcmp(p, kSignature.data(), kSignature.size()) != 0) return false;
-  if (p[16] != kProtocolVersion) return false;
+  if (version) *version = p[16];
   type = p[17];
   payload_size = readU32BE(p + 18);
   return true;
@@ -229,13 +229,9 @@ bool StreamParser::next(RawMessage& out) {
       continue;
     }
     if (avail < kHeaderSize) return false;
-    uint8_t type;
+    uint8_t type, version;
     uint32_t size;
-    if (!decodeHeader(p, type, size)) {
-      ++stats_.bad_version;
-      skip(1, true);
-      continue;
-    }
+    decodeHeader(p, type, size, &version);  // the signature was checked above
     if (size > max_payload_) {
       ++stats_.oversized;
       skip(1, true);
@@ -254,6 +250,7 @@ bool StreamParser::next(RawMessage& out) {
     if (inner == buf_.size() && end + kSignature.size() - 1 > buf_.size() && tailLooksLikeSignature(end))
       return false;  // a signature may be arriving across the payload's end: decide on more bytes
     out.type = type;
+    out.version = version;
     out.payload = p + kHeaderSize;
     out.size = size;
     pos_ += kHeaderSize + size;

@@ -22,6 +22,9 @@ using Clock = std::chrono::steady_clock;
 NavtechServer::NavtechServer(ServerOptions options, ScanSource source)
     : opt_(std::move(options)), source_(std::move(source)) {
   if (!opt_.log) opt_.log = stderrLog();
+  if (opt_.max_clients < 1)
+    throw std::invalid_argument("navtech server: max_clients = " + std::to_string(opt_.max_clients) +
+                                " must be at least 1");
   std::sort(opt_.faults.begin(), opt_.faults.end(),
             [](const ServerFault& a, const ServerFault& b) { return a.at_azimuth < b.at_azimuth; });
   port_ = opt_.port;
@@ -71,8 +74,10 @@ void NavtechServer::start() {
 void NavtechServer::stop() {
   running_ = false;
   if (thread_.joinable()) thread_.join();
-  if (client_ >= 0) ::close(client_);
-  client_ = -1;
+  for (auto& c : clients_)
+    if (c->fd >= 0) ::close(c->fd);
+  clients_.clear();
+  connected_ = 0;
   if (listen_fd_ >= 0) ::close(listen_fd_);
   listen_fd_ = -1;
 }
@@ -83,68 +88,6 @@ void NavtechServer::sleepFor(double s) {
   while (running_ && Clock::now() < until)
     std::this_thread::sleep_for(std::min<Clock::duration>(until - Clock::now(),
                                                          std::chrono::milliseconds(20)));
-}
-
-void NavtechServer::closeClient(const std::string& why) {
-  if (client_ < 0) return;
-  ::close(client_);
-  client_ = -1;
-  started_stream_ = false;
-  log(LogLevel::Info, "client left: " + why);
-}
-
-bool NavtechServer::sendAll(const uint8_t* data, size_t n) {
-  const auto give_up = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                          std::chrono::duration<double>(opt_.send_timeout));
-  while (n > 0 && client_ >= 0 && running_) {
-    const ssize_t k = ::send(client_, data, n, MSG_NOSIGNAL | MSG_DONTWAIT);
-    if (k > 0) {
-      data += k;
-      n -= size_t(k);
-      continue;
-    }
-    if (k < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
-      closeClient(std::string("send: ") + std::strerror(errno));
-      return false;
-    }
-    if (Clock::now() > give_up) {
-      {
-        std::lock_guard<std::mutex> lock(stats_mutex_);
-        ++stats_.dropped_clients;
-      }
-      closeClient("not reading for " + std::to_string(opt_.send_timeout) + " s (slow consumer)");
-      return false;
-    }
-    pollfd p{client_, POLLOUT, 0};
-    ::poll(&p, 1, 20);
-  }
-  return n == 0;
-}
-
-void NavtechServer::readCommands() {
-  uint8_t buf[512];
-  for (;;) {
-    const ssize_t n = ::recv(client_, buf, sizeof buf, MSG_DONTWAIT);
-    if (n == 0) return closeClient("closed by the client");
-    if (n < 0) {
-      if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)
-        closeClient(std::string("recv: ") + std::strerror(errno));
-      break;
-    }
-    commands_.feed(buf, size_t(n));
-  }
-  RawMessage m;
-  while (client_ >= 0 && commands_.next(m)) {
-    if (m.type == uint8_t(MsgType::StartFftData)) {
-      started_stream_ = true;
-    } else if (m.type == uint8_t(MsgType::StopFftData)) {
-      started_stream_ = false;
-    } else if (m.type == uint8_t(MsgType::ConfigurationRequest) && have_config_) {
-      out_.clear();
-      encodeConfiguration(out_, config_);
-      sendAll(out_.data(), out_.size());
-    }
-  }
 }
 
 bool NavtechServer::nextScan() {
@@ -181,28 +124,28 @@ bool NavtechServer::applyFaults() {
     }
     out_.clear();
     switch (f.kind) {
-      case ServerFault::Kind::Disconnect: closeClient("fault: disconnect"); return false;
+      case ServerFault::Kind::Disconnect: closeAll("fault: disconnect"); return false;
       case ServerFault::Kind::Stall: log(LogLevel::Info, "fault: stall"); sleepFor(f.value); break;
       case ServerFault::Kind::Garbage:
         for (int i = 0; i < int(f.value); ++i) {
           rng_ = rng_ * 6364136223846793005ull + 1442695040888963407ull;
           out_.push_back(uint8_t(rng_ >> 56));
         }
-        sendAll(out_.data(), out_.size());
+        broadcast(out_.data(), out_.size(), false);
         break;
       case ServerFault::Kind::Truncate: truncate_next_ = 1; break;
       case ServerFault::Kind::CorruptSignature: truncate_next_ = 2; break;
       case ServerFault::Kind::Oversized:
         encodeHeader(out_, MsgType::FftData8, uint32_t(f.value));
-        sendAll(out_.data(), out_.size());
+        broadcast(out_.data(), out_.size(), false);
         break;
       case ServerFault::Kind::NewConfiguration:
         if (f.has_config) config_ = f.config;
         encodeConfiguration(out_, config_);
-        sendAll(out_.data(), out_.size());
+        broadcast(out_.data(), out_.size(), false);
         break;
       case ServerFault::Kind::Restart:
-        closeClient("fault: restart");
+        closeAll("fault: restart");
         ::close(listen_fd_);
         listen_fd_ = -1;
         log(LogLevel::Info, "fault: restarting (down for " + std::to_string(f.value) + " s)");
@@ -210,12 +153,25 @@ bool NavtechServer::applyFaults() {
         if (f.has_config) config_ = f.config;
         if (!openListener()) log(LogLevel::Error, "cannot listen again after restart");
         return false;
+      case ServerFault::Kind::ClockStep:
+        clock_step_ns_ += int64_t(std::llround(f.value * 1e9));
+        log(LogLevel::Info, "fault: sensor clock steps by " + std::to_string(f.value) + " s");
+        break;
+      case ServerFault::Kind::Gap: {
+        // The sensor keeps turning: the azimuths of the gap are made and thrown away.
+        log(LogLevel::Info, "fault: gap of " + std::to_string(f.value) + " s");
+        const int64_t skip = std::llround(f.value * std::max(1, int(config_.packet_rate)));
+        for (int64_t i = 0; i < skip && running_; ++i)
+          if (!nextAzimuth()) return false;
+        sleepFor(f.value);
+        break;
+      }
     }
   }
-  return client_ >= 0;
+  return anyStarted();
 }
 
-bool NavtechServer::sendAzimuth() {
+bool NavtechServer::nextAzimuth() {
   if (row_ >= scan_.azimuths && !nextScan()) return false;
   const int n = config_.azimuth_samples, nb = config_.range_in_bins;
   // The source's scan is resampled when the configuration differs from it (after a fault).
@@ -225,29 +181,35 @@ bool NavtechServer::sendAzimuth() {
                                 : uint16_t(int64_t(row_) * config_.encoder_size / n);
   const int copy = std::min(nb, scan_.bins);
   const uint8_t* src = scan_.row(src_row);
-  const int64_t stamp = scan_.stamp_ns[src_row] + (opt_.wall_clock ? time_offset_ns_ : 0);
-  const uint64_t k = stats().azimuths_sent;
+  const int64_t stamp =
+      scan_.stamp_ns[src_row] + (opt_.wall_clock ? time_offset_ns_ : 0) + clock_step_ns_;
   out_.clear();
   if (opt_.bit_depth == 16) {
     bins16_.assign(size_t(nb), 0);
     for (int b = 0; b < copy; ++b) bins16_[b] = uint16_t(src[b] << 8);
-    encodeFft16(out_, uint16_t(k), encoder, stamp, bins16_.data(), bins16_.size(), opt_.time_order);
+    encodeFft16(out_, sweep_, encoder, stamp, bins16_.data(), bins16_.size(), opt_.time_order);
   } else {
     bins8_.assign(size_t(nb), 0);
     std::copy(src, src + copy, bins8_.begin());
-    encodeFft8(out_, uint16_t(k), encoder, stamp, bins8_.data(), bins8_.size(), opt_.time_order);
+    encodeFft8(out_, sweep_, encoder, stamp, bins8_.data(), bins8_.size(), opt_.time_order);
   }
+  ++sweep_;
+  // When the configuration has more rows than the scan, rows advance in configuration units.
+  row_ = same ? row_ + 1 : (row_ + 1 >= n ? scan_.azimuths : row_ + 1);
+  return true;
+}
+
+bool NavtechServer::sendAzimuth() {
+  if (!nextAzimuth()) return false;
   size_t len = out_.size();
   if (truncate_next_ == 1) len /= 2;
   if (truncate_next_ == 2) out_[5] ^= 0xFF;
   truncate_next_ = 0;
-  // When the configuration has more rows than the scan, rows advance in configuration units.
-  row_ = same ? row_ + 1 : (row_ + 1 >= n ? scan_.azimuths : row_ + 1);
   {
     std::lock_guard<std::mutex> lock(stats_mutex_);
     ++stats_.azimuths_sent;
   }
-  sendAll(out_.data(), len);
+  broadcast(out_.data(), len, true);
   return true;
 }
 
@@ -256,65 +218,54 @@ void NavtechServer::run() {
   auto next_keep_alive = Clock::now();
   const auto keep_alive = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(opt_.keep_alive_period));
+  bool streaming = false;
   while (running_) {
-    if (client_ < 0) {
-      if (finished_ || listen_fd_ < 0) {
-        sleepFor(0.02);
-        if (listen_fd_ < 0 && !finished_) openListener();
-        continue;
-      }
+    if (listen_fd_ < 0 && !finished_) openListener();
+    if (listen_fd_ >= 0 && !finished_) {
       pollfd p{listen_fd_, POLLIN, 0};
-      if (::poll(&p, 1, 20) <= 0) continue;
-      const int fd = ::accept4(listen_fd_, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
-      if (fd < 0) continue;
-      const int one = 1;
-      setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-      client_ = fd;
-      commands_.reset();
-      started_stream_ = opt_.stream_without_start;
-      {
-        std::lock_guard<std::mutex> lock(stats_mutex_);
-        ++stats_.clients;
-      }
-      log(LogLevel::Info, "client connected");
-      if (!have_config_ && (row_ = 0, !nextScan())) {
-        finished_ = true;
-        closeClient("no data to serve");
-        continue;
-      }
-      out_.clear();
-      encodeConfiguration(out_, config_);
-      sendAll(out_.data(), out_.size());
-      next_due = next_keep_alive = Clock::now();
+      if (::poll(&p, 1, 0) > 0) acceptClient();
+    }
+    for (auto& c : clients_) {
+      if (c->fd >= 0) readCommands(*c);
+      flush(*c);
+    }
+    removeClosed();
+    if (clients_.empty()) {
+      streaming = false;
+      waitForEvents(20);
       continue;
     }
-    readCommands();
-    if (client_ < 0) continue;
     const auto now = Clock::now();
     if (now >= next_keep_alive) {
       out_.clear();
       encodeEmpty(out_, MsgType::KeepAlive);
-      sendAll(out_.data(), out_.size());
+      broadcast(out_.data(), out_.size(), false);
       next_keep_alive = now + keep_alive;
     }
-    if (!started_stream_ || client_ < 0) {
-      pollfd p{client_, POLLIN, 0};
-      ::poll(&p, 1, 20);
+    if (!anyStarted()) {
+      streaming = false;
+      waitForEvents(20);
       continue;
     }
+    if (!streaming) next_due = now;  // the first client to start sets the pace
+    streaming = true;
     if (opt_.rate > 0 && now < next_due) {
-      pollfd p{client_, POLLIN, 0};
       const auto wait = std::chrono::duration_cast<std::chrono::milliseconds>(next_due - now);
       if (wait.count() > 2)
-        ::poll(&p, 1, int(std::min<int64_t>(wait.count() - 1, 20)));
+        waitForEvents(int(std::min<int64_t>(wait.count() - 1, 20)));
       else
         std::this_thread::sleep_until(next_due);  // sub-millisecond pacing
+      continue;
+    }
+    if (opt_.rate <= 0 && backlogged()) {  // as fast as the slowest started client reads
+      waitForEvents(20);
       continue;
     }
     if (!applyFaults()) continue;
     if (!sendAzimuth()) {
       finished_ = true;
-      closeClient("end of the scan source");
+      drain();
+      closeAll("end of the scan source");
       continue;
     }
     if (opt_.rate > 0) {

@@ -1,5 +1,6 @@
 #include "spinradar/driver/navtech_time.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace spinradar::navtech {
@@ -52,6 +53,25 @@ bool SensorTimeDecoder::decode(const FftData& m, int64_t& stamp_ns) {
   if (ns >= 1000000000u) return false;
   stamp_ns = int64_t(m.seconds(be)) * 1000000000 + ns;
   return true;
+}
+
+int64_t StampChecker::check(int64_t stamp_ns, uint16_t encoder, const Configuration& c) {
+  const bool had = have_last_;
+  const int64_t prev_ns = last_stamp_ns_;
+  const int prev_encoder = last_encoder_;
+  have_last_ = true;
+  last_stamp_ns_ = stamp_ns;
+  last_encoder_ = encoder;
+  if (!had || c.encoder_size == 0 || c.rotation_mhz == 0) return 0;
+  const int e = c.encoder_size;
+  const int turned = ((int(encoder) - prev_encoder) % e + e) % e;
+  const double expected_ns = 1e9 * turned / (double(e) * c.rotationHz());
+  // In double: stamps come off the wire and may be anything.
+  const double off = double(stamp_ns) - double(prev_ns) - expected_ns;
+  if (std::fabs(off) <= double(tolerance_ns_)) return 0;
+  if (off > 9e18) return int64_t(9e18);
+  if (off < -9e18) return int64_t(-9e18);
+  return int64_t(off);
 }
 
 void ClockMapper::reset() {

@@ -43,6 +43,11 @@ InputStatus ByteStreamInput::next(Packet& packet, std::chrono::milliseconds time
     RawMessage m;
     while (parser_.next(m)) {
       const auto type = MsgType(m.type);
+      if (!version_logged_) {  // any version is accepted; say which one this sensor sends
+        version_logged_ = true;
+        log(LogLevel::Info, "protocol version byte " + std::to_string(m.version) +
+                                (m.version == kProtocolVersion ? "" : " (accepted)"));
+      }
       onMessage(type);
       packet.receive_ns = chunk_receive_ns_;
       switch (type) {
@@ -72,13 +77,14 @@ InputStatus ByteStreamInput::next(Packet& packet, std::chrono::milliseconds time
         case MsgType::StopFftData: break;  // client-to-sensor messages: nothing to do
         default:
           if (stats_.unknown_types++ % 1000 == 0)
-            log(LogLevel::Debug, "skipping message of unknown type " + std::to_string(m.type));
+            log(LogLevel::Warn, "skipping message of unknown type " + std::to_string(m.type) + " (" +
+                                    std::to_string(stats_.unknown_types) + " so far)");
       }
     }
     logFraming();
     chunk_.clear();
     const InputStatus st = readSome(chunk_, chunk_receive_ns_, deadline);
-    if (st == InputStatus::Disconnected) parser_.reset();
+    if (st == InputStatus::Disconnected) resetStream();
     if (st != InputStatus::Ok) return st;
     parser_.feed(chunk_.data(), chunk_.size());
   }
@@ -94,9 +100,6 @@ void ByteStreamInput::logFraming() {
   if (now.oversized > logged_.oversized)
     log(LogLevel::Warn, "refused header(s) announcing a payload over 1 MB (" +
                             std::to_string(now.oversized) + " so far)");
-  if (now.bad_version > logged_.bad_version)
-    log(LogLevel::Warn, "header(s) with a wrong protocol version skipped (" +
-                            std::to_string(now.bad_version) + " so far)");
   if (now.truncated > logged_.truncated)
     log(LogLevel::Warn, "message cut short by a new header: dropped (" +
                             std::to_string(now.truncated) + " so far)");

@@ -124,10 +124,14 @@ bool ScanAssembler::finish(AssembledScan& out) {
       last_valid = a;
     }
   }
-  stats_.missing_azimuths += uint64_t(missing);
+  if (!partial) stats_.missing_azimuths += uint64_t(missing);
   stats_.duplicated_azimuths += uint64_t(duplicated);
   const int valid = n - missing - duplicated;
-  if ((partial && opt_.drop_partial) || valid < opt_.min_valid_fraction * n || first_valid < 0) {
+  if (partial && opt_.drop_partial) {
+    ++stats_.partial_scans;
+    return false;
+  }
+  if (valid < opt_.min_valid_fraction * n || first_valid < 0) {
     ++stats_.dropped_scans;
     return false;
   }

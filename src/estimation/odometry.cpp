@@ -3,6 +3,7 @@
 #include "spinradar/estimation/odometry.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 
@@ -84,6 +85,7 @@ struct Odometry::Impl {
   Eigen::Matrix3d pose_cov = Eigen::Matrix3d::Zero();
   MotionEstimate last;  ///< last successful estimate (for a failed scan's prediction)
   bool has_last = false;
+  int64_t period_ns = 0;  ///< shortest interval between scans seen (the scan period)
 
   explicit Impl(const PipelineConfig& c) { apply(c); }
 
@@ -158,10 +160,35 @@ struct Odometry::Impl {
     return false;
   }
 
+  /// Time going backwards, or a gap of several scan periods, starts a new segment: nothing is
+  /// matched or extrapolated across it, the pose is kept (tf stays continuous) and the motion
+  /// that may have happened meanwhile (last speed plus a margin, over the gap, or over one
+  /// period when time went back) goes into its covariance.
+  void checkTime(OdometryResult& res) {
+    using TimeEvent = OdometryResult::TimeEvent;
+    const int64_t dt_ns = cur.frame.stamp_ns - prev.frame.stamp_ns;
+    if (dt_ns > 0 && !(period_ns > 0 && double(dt_ns) > Odometry::kGapPeriods * double(period_ns))) {
+      period_ns = period_ns > 0 ? std::min(period_ns, dt_ns) : dt_ns;
+      return;
+    }
+    res.time_event = dt_ns > 0 ? TimeEvent::Gap : TimeEvent::Backwards;
+    res.time_step_s = 1e-9 * static_cast<double>(dt_ns);
+    const double lost_s = 1e-9 * static_cast<double>(dt_ns > 0 ? dt_ns : period_ns);
+    const Eigen::Vector3d v = has_last ? last.velocity : Eigen::Vector3d::Zero();
+    const double s_xy = (std::hypot(v(0), v(1)) + 1.0) * lost_s;   // + 1 m/s
+    const double s_yaw = (std::abs(v(2)) + 0.1) * lost_s;          // + 0.1 rad/s
+    pose_cov.diagonal() += Eigen::Vector3d(s_xy * s_xy, s_xy * s_xy, s_yaw * s_yaw);
+    has_prev = false;
+    has_last = false;
+    refined.reset();
+    keyframe.reset();
+  }
+
   /// Estimation and compounding on cur (prev is the previous scan, when there is one).
   OdometryResult step(StageTimes times) {
     OdometryResult res;
     res.stamp_ns = cur.frame.stamp_ns;
+    if (has_prev) checkTime(res);
     const std::vector<Keypoint>& kps = cur.frame.keypoints;
     raw.resize(kps.size());
     for (size_t i = 0; i < kps.size(); ++i) raw[i] = {kps[i].x, kps[i].y};

@@ -41,6 +41,7 @@ struct ServeOptions {
   bool sim_clock = false;
   std::string time_order = "little";
   uint64_t seed = 1;
+  int max_clients = spinradar::navtech::ServerOptions{}.max_clients;
 };
 
 void serve(const ServeOptions& o) {
@@ -55,13 +56,15 @@ void serve(const ServeOptions& o) {
   so.rotation_hz = sim->sensor().rotation_hz;
   so.bit_depth = o.bit_depth;
   so.wall_clock = !o.sim_clock;
+  so.max_clients = o.max_clients;
   so.time_order = navtech::parseTimeByteOrder(o.time_order);
   if (so.time_order == navtech::TimeByteOrder::Auto) so.time_order = navtech::TimeByteOrder::Little;
   navtech::NavtechServer server(so, sim::simScanSource(sim, 0, o.loop));
   server.start();
   std::cerr << "serve: scene '" << o.scene << "' (" << sim->scanCount() << " rotations) on "
             << o.bind << ":" << server.port() << " at " << o.rate << "x real time"
-            << (o.sim_clock ? ", simulator clock" : ", wall clock") << "; Ctrl-C to stop"
+            << (o.sim_clock ? ", simulator clock" : ", wall clock") << ", up to " << o.max_clients
+            << " client(s) at once; Ctrl-C to stop"
             << std::endl;
   std::signal(SIGINT, [](int) { g_stop = true; });
   std::signal(SIGTERM, [](int) { g_stop = true; });
@@ -110,5 +113,9 @@ SPINRADAR_COMMAND("serve", "Serve a simulated scene as a live Navtech radar (TCP
                         ->check(CLI::IsMember({"little", "big"}))
                         ->capture_default_str();
                     app.add_option("--seed", o->seed, "Simulator noise seed")->capture_default_str();
+                    app.add_option("--max-clients", o->max_clients,
+                                   "Clients streamed to at once, each with its own start/stop; one more is refused (log line)")
+                        ->check(CLI::Range(1, 64))
+                        ->capture_default_str();
                     app.callback([o] { serve(*o); });
                   });

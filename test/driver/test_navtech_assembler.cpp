@@ -130,7 +130,8 @@ TEST(NavtechAssembler, PartialFirstRotationDroppedOrMarked) {
       ASSERT_EQ(scans.size(), 1u);
       EXPECT_FALSE(scans[0].partial);
       EXPECT_EQ(scans[0].missing, 0);
-      EXPECT_EQ(a.stats().dropped_scans, 1u);
+      EXPECT_EQ(a.stats().partial_scans, 1u);
+      EXPECT_EQ(a.stats().dropped_scans, 0u);
     } else {
       ASSERT_EQ(scans.size(), 2u);
       EXPECT_TRUE(scans[0].partial);
@@ -138,6 +139,8 @@ TEST(NavtechAssembler, PartialFirstRotationDroppedOrMarked) {
       for (int r = 0; r < 5; ++r) EXPECT_EQ(scans[0].scan.valid[r], 0);
       EXPECT_EQ(scans[0].scan.valid[5], 1);
     }
+    // The rows before we joined were never sent to us: not counted as lost.
+    EXPECT_EQ(a.stats().missing_azimuths, 0u);
   }
 }
 

@@ -53,9 +53,10 @@ TEST(NavtechProtocol, HeaderFromHandBuiltBytes) {
   ASSERT_TRUE(decodeHeader(b.data(), type, size));
   EXPECT_EQ(type, 31);
   EXPECT_EQ(size, 0x00010203u);  // big-endian
-  b[16] = 2;                      // wrong version
-  EXPECT_FALSE(decodeHeader(b.data(), type, size));
-  b[16] = 1;
+  b[16] = 2;                      // any version byte is accepted and reported
+  uint8_t version = 99;
+  EXPECT_TRUE(decodeHeader(b.data(), type, size, &version));
+  EXPECT_EQ(version, 2);
   b[3] = 0x04;  // wrong signature
   EXPECT_FALSE(decodeHeader(b.data(), type, size));
 }
@@ -255,16 +256,36 @@ TEST(NavtechProtocol, ParserWaitsForTruncatedTailAcrossReads) {
   EXPECT_EQ(m.payload[15], 6);
 }
 
-TEST(NavtechProtocol, WrongVersionSkipped) {
-  auto bad = header(30, 3);
-  bad[16] = 7;
-  bad.insert(bad.end(), {1, 2, 3});
-  const auto fft = handFft8(false, {42});
-  bad.insert(bad.end(), fft.begin(), fft.end());
+TEST(NavtechProtocol, StartFftDataWithVersionZeroAccepted) {
+  // The exact Start FFT Data message of Navtech's SDK example ReadOneRotationOfFFTData.py:
+  // protocol version byte 0 (its `version` variable is never set). Real radars answer it.
+  const std::vector<uint8_t> start = {0x00, 0x01, 0x03, 0x03, 0x07, 0x07, 0x0F, 0x0F,
+                                      0x1F, 0x1F, 0x3F, 0x3F, 0x7F, 0x7F, 0xFE, 0xFE,
+                                      0x00, 0x15, 0x00, 0x00, 0x00, 0x00};
   StreamParser p;
-  auto msgs = parseAll(p, bad);
-  ASSERT_EQ(msgs.size(), 1u);
-  EXPECT_EQ(p.stats().bad_version, 1u);
+  for (size_t chunk : {size_t(1), size_t(7), size_t(64)}) {
+    auto msgs = parseAll(p, start, chunk);
+    ASSERT_EQ(msgs.size(), 1u) << "chunk " << chunk;
+    EXPECT_EQ(msgs[0].type, uint8_t(MsgType::StartFftData));
+    EXPECT_EQ(msgs[0].version, 0);
+    EXPECT_EQ(msgs[0].size, 0u);
+  }
+  EXPECT_EQ(p.stats().garbage_bytes, 0u);
+}
+
+TEST(NavtechProtocol, FftDataWithAnyVersionDecoded) {
+  for (uint8_t version : {uint8_t(0), uint8_t(1), uint8_t(2), uint8_t(255)}) {
+    auto b = handFft8(false, {42, 43});
+    b[16] = version;
+    StreamParser p;
+    auto msgs = parseAll(p, b);
+    ASSERT_EQ(msgs.size(), 1u) << int(version);
+    EXPECT_EQ(msgs[0].version, version);
+    FftData d;
+    ASSERT_TRUE(decodeFft(MsgType(msgs[0].type), msgs[0].payload, msgs[0].size, d));
+    EXPECT_EQ(d.encoder, 1400);
+    EXPECT_EQ(d.power, (std::vector<uint16_t>{42, 43}));
+  }
 }
 
 TEST(NavtechProtocol, GarbageMemoryStaysBounded) {

@@ -19,6 +19,7 @@
   X(std::string, time_source, "sensor", 0, 0, "", "Azimuth stamps: sensor, receive or smoothed (sensor mapped onto receive clock)") \
   X(std::string, time_byte_order, "auto", 0, 0, "", "Byte order of the sensor's seconds/nanoseconds: auto, little or big") \
   X(double, smoothing_window, 5.0, 0.1, 600.0, "s", "Window of the smoothed sensor-to-receive clock mapping") \
+  X(double, time_jump_tolerance, 0.1, 0.001, 10.0, "s", "Sensor time off the rotation rate by more than this (clock step or gap) drops the rotation in progress and re-anchors the clock mapping") \
   X(bool, drop_partial, true, 0, 0, "", "Drop (true) or publish with invalid rows (false) a rotation joined mid-way") \
   X(double, min_valid_fraction, 0.5, 0.0, 1.0, "", "Drop rotations with fewer valid azimuths than this fraction") \
   X(double, fft16_divisor, 256.0, 1.0, 65536.0, "", "16-bit FFT value / divisor = 8-bit power of the core scan") \

@@ -16,12 +16,16 @@ namespace spinradar::navtech {
 struct DriverStats {
   uint64_t azimuths = 0;           ///< FFT messages received
   uint64_t scans = 0;              ///< rotations returned by poll()
-  uint64_t dropped_scans = 0;      ///< partial, too sparse, or cut by a disconnect
-  uint64_t missing_azimuths = 0;
+  uint64_t dropped_scans = 0;      ///< too sparse, or cut by a disconnect or a time anomaly
+  uint64_t partial_scans = 0;      ///< joined mid-way (at every connect): dropped, expected
+  uint64_t missing_azimuths = 0;   ///< only inside rotations streamed from their start
   uint64_t duplicated_azimuths = 0;
   uint64_t implausible_times = 0;  ///< azimuths whose sensor time was unusable
   uint64_t configurations = 0;
   uint64_t clock_jumps = 0;        ///< smoothed mapping restarts
+  uint64_t time_anomalies = 0;     ///< sensor time off the rotation rate (step back, jump ahead)
+  std::string last_time_anomaly;   ///< what happened and when (UTC), empty when none
+  int64_t last_time_anomaly_ns = 0;  ///< receive time (wall clock) of that azimuth
   InputStats input;
   TimeByteOrder byte_order = TimeByteOrder::Little;
 };
@@ -44,12 +48,13 @@ class NavtechDriver {
   const Configuration& configuration() const { return assembler_.configuration(); }
 
  private:
-  void init();
+  void onTimeAnomaly(int64_t off_ns, int64_t receive_ns);
   DriverConfig config_;
   std::unique_ptr<RadarInput> input_;
   TimeSource time_source_;
   SensorTimeDecoder time_decoder_;
   ClockMapper mapper_;
+  StampChecker stamp_checker_;
   ScanAssembler assembler_;
   Packet packet_;
   DriverStats stats_;

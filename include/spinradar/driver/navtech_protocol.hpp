@@ -14,6 +14,8 @@ namespace spinradar::navtech {
 constexpr std::array<uint8_t, 16> kSignature = {0x00, 0x01, 0x03, 0x03, 0x07, 0x07, 0x0F, 0x0F,
                                                 0x1F, 0x1F, 0x3F, 0x3F, 0x7F, 0x7F, 0xFE, 0xFE};
 constexpr size_t kHeaderSize = 22;
+/// The version byte this project sends. Received messages are accepted whatever their version
+/// byte: Navtech's own SDK examples send 0 and real radars answer them.
 constexpr uint8_t kProtocolVersion = 1;
 /// Payloads larger than this are refused (the largest real FFT message is ~14 KB).
 constexpr uint32_t kMaxPayload = 1u << 20;
@@ -73,8 +75,10 @@ uint16_t readU16BE(const uint8_t* p);
 uint32_t readU32BE(const uint8_t* p);
 uint32_t readU32LE(const uint8_t* p);
 
-/// Parses a 22-byte header. Returns false when the signature or version is wrong.
-bool decodeHeader(const uint8_t* p, uint8_t& type, uint32_t& payload_size);
+/// Parses a 22-byte header. Returns false when the signature is wrong; any version byte is
+/// accepted (written to `version` when given).
+bool decodeHeader(const uint8_t* p, uint8_t& type, uint32_t& payload_size,
+                  uint8_t* version = nullptr);
 /// Returns false when the payload is shorter than 20 bytes.
 bool decodeConfiguration(const uint8_t* payload, size_t size, Configuration& out);
 /// Returns false when the payload is malformed (too short, data offset outside the payload,
@@ -97,6 +101,7 @@ void encodeFft16(std::vector<uint8_t>& out, uint16_t sweep, uint16_t encoder, in
 /// buffer and stays valid until the next call to feed() or next().
 struct RawMessage {
   uint8_t type = 0;
+  uint8_t version = 0;  ///< the header's protocol version byte, as sent
   const uint8_t* payload = nullptr;
   uint32_t size = 0;
 };
@@ -107,7 +112,6 @@ struct StreamStats {
   uint64_t garbage_bytes = 0;     ///< bytes skipped while looking for a signature
   uint64_t resyncs = 0;           ///< times the parser had to search for a signature
   uint64_t oversized = 0;         ///< headers refused for a payload over the limit
-  uint64_t bad_version = 0;       ///< headers refused for a wrong protocol version
   uint64_t truncated = 0;         ///< messages cut short by a new signature inside the payload
 };
 

@@ -1,12 +1,17 @@
 #pragma once
-// A Navtech sensor emulator on a loopback TCP port: sends the configuration on connect,
-// streams one FFT message per azimuth after Start FFT Data (at real-time rate or a multiple),
-// sends keep-alives, and survives clients connecting, leaving and reconnecting. Fed by any
-// scan source (the simulator for `spinradar serve`, synthetic scans in tests). A scriptable
+// A Navtech sensor emulator on a loopback TCP port. Like a real radar it serves several clients
+// at once (up to ServerOptions::max_clients): each gets the configuration on connect and on
+// request, and FFT messages between its own Start and Stop FFT Data; all share one turning
+// sensor (one azimuth stream at real-time rate or a multiple). Commands are accepted whatever
+// their protocol version byte (Navtech's SDK examples send 0). Keep-alives, clients leaving and
+// reconnecting, slow clients (dropped after send_timeout, never stalling the others). Fed by
+// any scan source (the simulator for `spinradar serve`, synthetic scans in tests). A scriptable
 // fault list makes it misbehave on cue for reliability tests.
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -31,8 +36,11 @@ struct ServerFault {
     Oversized,         ///< send a header announcing `value` bytes of payload, and no payload
     NewConfiguration,  ///< switch to `config` and send it mid-stream
     Restart,           ///< drop the client, refuse connections for `value` s, come back with `config`
+    ClockStep,         ///< the sensor clock reads `value` s later from now on (negative: steps back)
+    Gap,               ///< the sensor turns on but sends nothing (no keep-alive) for `value` s
   };
   uint64_t at_azimuth = 0;  ///< applied before FFT message number `at_azimuth` (0-based, global)
+  /// Faults apply to every connected client (Disconnect and Restart drop them all).
   Kind kind = Kind::Disconnect;
   double value = 0;
   bool has_config = false;
@@ -50,12 +58,16 @@ struct ServerOptions {
   double keep_alive_period = 1.0; ///< s
   double send_timeout = 2.0;      ///< s a client may block a send before it is dropped
   bool stream_without_start = false;  ///< stream FFT data even before Start FFT Data
+  /// Clients served at once (the `serve --max-clients` option reads its default here). One
+  /// more is accepted, logged as refused and closed at once, so it is never left hanging.
+  int max_clients = 4;
   std::vector<ServerFault> faults;    ///< sorted by at_azimuth
   LogFn log;                          ///< default: stderr
 };
 
 struct ServerStats {
   uint64_t clients = 0;         ///< connections accepted
+  uint64_t refused_clients = 0; ///< connections closed at once (max_clients reached)
   uint64_t azimuths_sent = 0;   ///< FFT messages sent (global counter used by faults)
   uint64_t scans_started = 0;   ///< rotations taken from the source
   uint64_t faults_applied = 0;
@@ -74,15 +86,38 @@ class NavtechServer {
   int port() const { return port_; }
   ServerStats stats() const;
   bool finished() const { return finished_; }  ///< the source ran out
-  bool clientConnected() const { return client_ >= 0; }
+  bool clientConnected() const { return connected_ > 0; }
+  int clientCount() const { return connected_; }
 
  private:
+  struct Client {
+    int fd = -1;
+    uint64_t id = 0;
+    std::string peer;
+    StreamParser commands;
+    bool started = false;
+    bool version_logged = false;
+    std::vector<uint8_t> pending;  ///< bytes its socket did not take yet
+    std::chrono::steady_clock::time_point blocked_since{};
+  };
+
   void run();
   bool openListener();
-  void closeClient(const std::string& why);
-  bool sendAll(const uint8_t* data, size_t n);
+  void acceptClient();
+  void closeClient(Client& c, const std::string& why);
+  void closeAll(const std::string& why);
+  void removeClosed();
+  void send(Client& c, const uint8_t* data, size_t n);
+  void flush(Client& c);
+  void broadcast(const uint8_t* data, size_t n, bool started_only);
+  void drain();  ///< sends what is pending (at most send_timeout), e.g. before closing
+  void sendConfiguration(Client& c);
+  bool anyStarted() const;
+  bool backlogged() const;
+  void waitForEvents(int timeout_ms);
   bool sendAzimuth();
-  void readCommands();
+  bool nextAzimuth();  ///< encodes the next azimuth into out_ and advances; false at the end
+  void readCommands(Client& c);
   bool applyFaults();
   bool nextScan();
   void sleepFor(double s);
@@ -96,18 +131,19 @@ class NavtechServer {
   int row_ = 0;
   int64_t time_offset_ns_ = 0;
   bool time_offset_set_ = false;
+  int64_t clock_step_ns_ = 0;  ///< ClockStep faults so far
+  uint16_t sweep_ = 0;         ///< the FFT messages' counter (runs on through a Gap)
   std::vector<uint8_t> out_;
   std::vector<uint16_t> bins16_;
   std::vector<uint8_t> bins8_;
-  StreamParser commands_;
   size_t next_fault_ = 0;
   int truncate_next_ = 0;  ///< 1 truncate, 2 corrupt signature
   uint64_t rng_ = 0x9E3779B97F4A7C15ull;
 
   int listen_fd_ = -1;
-  std::atomic<int> client_{-1};
+  std::vector<std::unique_ptr<Client>> clients_;
+  std::atomic<int> connected_{0};
   std::atomic<int> port_{0};
-  bool started_stream_ = false;
   std::atomic<bool> running_{false};
   std::atomic<bool> finished_{false};
   std::thread thread_;

@@ -57,6 +57,25 @@ class ClockMapper {
   uint64_t jumps_ = 0;
 };
 
+/// Checks each azimuth's sensor time against the rotation rate: from one azimuth to the next the
+/// time must advance by (encoder counts turned) / (encoder_size * rotation Hz). An azimuth off
+/// by more than the tolerance marks a step of the sensor clock (back or forward) or a gap in
+/// the data longer than the turn suggests; either way the rotation it falls in is not one turn.
+class StampChecker {
+ public:
+  explicit StampChecker(int64_t tolerance_ns = 100'000'000) : tolerance_ns_(tolerance_ns) {}
+  /// Returns how far the stamp is off the expected one (negative: back in time), 0 when
+  /// within the tolerance or when there is nothing to compare with.
+  int64_t check(int64_t stamp_ns, uint16_t encoder, const Configuration& config);
+  void reset() { have_last_ = false; }  ///< after a disconnect or a new configuration
+
+ private:
+  int64_t tolerance_ns_;
+  bool have_last_ = false;
+  int64_t last_stamp_ns_ = 0;
+  uint16_t last_encoder_ = 0;
+};
+
 /// Which time an azimuth gets: `sensor` (decoded sensor time; receive time for an azimuth
 /// whose sensor time is implausible), `receive`, or `smoothed` (sensor time mapped onto the
 /// receive clock by ClockMapper).

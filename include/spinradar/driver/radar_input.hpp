@@ -75,7 +75,10 @@ class ByteStreamInput : public RadarInput {
                                std::chrono::steady_clock::time_point deadline) = 0;
   /// Called for every framed message before decoding (the socket answers a configuration).
   virtual void onMessage(MsgType type) {}
-  void resetStream() { parser_.reset(); }
+  void resetStream() {
+    parser_.reset();
+    version_logged_ = false;  // logged again on the next connection
+  }
 
   InputStats stats_;
 
@@ -83,6 +86,7 @@ class ByteStreamInput : public RadarInput {
   void logFraming();
   StreamParser parser_;
   StreamStats logged_;
+  bool version_logged_ = false;
   std::vector<uint8_t> chunk_;
   int64_t chunk_receive_ns_ = 0;
 };

@@ -44,8 +44,11 @@ struct AssembledScan {
 
 struct AssemblerStats {
   uint64_t scans = 0;
-  uint64_t dropped_scans = 0;     ///< partial or too few valid rows
-  uint64_t missing_azimuths = 0;  ///< summed over emitted and dropped rotations
+  uint64_t dropped_scans = 0;     ///< too few valid rows, or cut by a reset (disconnect, time step)
+  uint64_t partial_scans = 0;     ///< joined mid-way (after a connect or reset), dropped as asked
+  /// Rows lost inside rotations streamed from their start (emitted or dropped); the rows of a
+  /// rotation joined mid-way were never sent to us and are not counted.
+  uint64_t missing_azimuths = 0;
   uint64_t duplicated_azimuths = 0;
   uint64_t malformed = 0;
   uint64_t resets = 0;

@@ -36,6 +36,14 @@ struct OdometryResult {
   int64_t keyframe_stamp_ns = 0;
   Eigen::Matrix3d T_keyframe_sensor = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d keyframe_cov = Eigen::Matrix3d::Zero();
+  /// Set when this scan starts a new segment because of its stamp: Backwards (not after the
+  /// previous scan's: a clock step or a restarted source; the state is cleared) or Gap (more
+  /// than Odometry::kGapPeriods scan periods since the previous scan: nothing is extrapolated
+  /// across it). Either way the pose is kept (continuous), its covariance inflated, and the
+  /// velocity is estimated again from the next pair.
+  enum class TimeEvent { None, Backwards, Gap };
+  TimeEvent time_event = TimeEvent::None;
+  double time_step_s = 0;  ///< this stamp minus the previous scan's (set with time_event)
   StageTimes times;
 };
 

@@ -20,6 +20,10 @@ namespace spinradar {
 
 class Odometry {
  public:
+  /// A scan more than this many scan periods (the shortest interval seen) after the previous
+  /// one starts a new segment (OdometryResult::time_event).
+  static constexpr double kGapPeriods = 4.0;
+
   explicit Odometry(const PipelineConfig& config);  ///< validates config (throws)
   ~Odometry();
   Odometry(Odometry&&) noexcept;
