@@ -22,6 +22,9 @@ using Clock = std::chrono::steady_clock;
 NavtechServer::NavtechServer(ServerOptions options, ScanSource source)
     : opt_(std::move(options)), source_(std::move(source)) {
   if (!opt_.log) opt_.log = stderrLog();
+  if (opt_.encoder_phase < 0)
+    throw std::invalid_argument("navtech server: encoder_phase = " + std::to_string(opt_.encoder_phase) +
+                                " must not be negative");
   if (opt_.max_clients < 1)
     throw std::invalid_argument("navtech server: max_clients = " + std::to_string(opt_.max_clients) +
                                 " must be at least 1");
@@ -177,8 +180,9 @@ bool NavtechServer::nextAzimuth() {
   // The source's scan is resampled when the configuration differs from it (after a fault).
   const bool same = n == scan_.azimuths && nb == scan_.bins;
   const int src_row = same ? row_ : int(int64_t(row_) * scan_.azimuths / n);
-  const uint16_t encoder = same ? scan_.encoder[row_]
-                                : uint16_t(int64_t(row_) * config_.encoder_size / n);
+  const uint16_t encoder = uint16_t(
+      ((same ? scan_.encoder[row_] : int64_t(row_) * config_.encoder_size / n) + opt_.encoder_phase) %
+      std::max<int>(1, config_.encoder_size));
   const int copy = std::min(nb, scan_.bins);
   const uint8_t* src = scan_.row(src_row);
   const int64_t stamp =
@@ -257,7 +261,7 @@ void NavtechServer::run() {
         std::this_thread::sleep_until(next_due);  // sub-millisecond pacing
       continue;
     }
-    if (opt_.rate <= 0 && backlogged()) {  // as fast as the slowest started client reads
+    if (opt_.rate <= 0 && !allCaughtUp()) {  // as fast as the slowest started client reads
       waitForEvents(20);
       continue;
     }

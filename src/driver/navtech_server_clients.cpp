@@ -1,10 +1,15 @@
 // NavtechServer, the client side: accepting (up to max_clients, refusing the next with a log
 // line), commands of each client (any protocol version byte), non-blocking sends with a
-// per-client backlog so a slow client is dropped without stalling the others.
+// whole messages only, so a slow client misses messages (and is dropped when it takes nothing)
+// without stalling the others.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <poll.h>
+#include <linux/sockios.h>
+#include <sys/ioctl.h>
+#include <linux/sockios.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -85,33 +90,40 @@ void NavtechServer::removeClosed() {
 
 void NavtechServer::send(Client& c, const uint8_t* data, size_t n) {
   if (c.fd < 0 || n == 0) return;
-  if (c.pending.empty()) {
-    const ssize_t k = ::send(c.fd, data, n, MSG_NOSIGNAL | MSG_DONTWAIT);
-    if (k < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)
-      return closeClient(c, std::string("send: ") + std::strerror(errno));
-    const size_t sent = k > 0 ? size_t(k) : 0;
-    if (sent == n) return;
-    data += sent;
-    n -= sent;
-    c.blocked_since = Clock::now();
-  }
-  // What the socket did not take waits here, in order; a client that stops reading is
-  // dropped (flush) instead of slowing down the others.
-  c.pending.insert(c.pending.end(), data, data + n);
-  if (c.pending.size() > kMaxPayload * 16) flush(c);
+  if (c.queue.empty()) c.blocked_since = Clock::now();
+  c.queue.emplace_back(data, data + n);
+  c.queued_bytes += n;
+  flush(c);
+}
+
+int NavtechServer::unsent(const Client& c) const {
+  int n = 0;
+  return ioctl(c.fd, SIOCOUTQNSD, &n) == 0 ? n : 0;
 }
 
 void NavtechServer::flush(Client& c) {
-  if (c.fd < 0 || c.pending.empty()) return;
-  const ssize_t k = ::send(c.fd, c.pending.data(), c.pending.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
-  if (k < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)
-    return closeClient(c, std::string("send: ") + std::strerror(errno));
-  if (k > 0) {
-    c.pending.erase(c.pending.begin(), c.pending.begin() + k);
+  // Messages leave one at a time, each once the kernel has sent all before it: then a
+  // window-limited socket never holds a message in pieces, and a client a few messages behind
+  // (Navtech's Python example reads slower than 1600 azimuths/s and cannot cope with a short
+  // recv()) never meets half a message.
+  while (c.fd >= 0 && !c.queue.empty()) {
+    if (c.head_sent == 0 && unsent(c) > 0) break;
+    const std::vector<uint8_t>& m = c.queue.front();
+    const ssize_t k = ::send(c.fd, m.data() + c.head_sent, m.size() - c.head_sent,
+                             MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (k < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)
+      return closeClient(c, std::string("send: ") + std::strerror(errno));
+    if (k <= 0) break;
     c.blocked_since = Clock::now();
+    c.head_sent += size_t(k);
+    if (c.head_sent < m.size()) break;
+    c.queued_bytes -= m.size();
+    c.head_sent = 0;
+    c.queue.pop_front();
   }
+  if (c.fd < 0 || c.queue.empty()) return;
   const double blocked = std::chrono::duration<double>(Clock::now() - c.blocked_since).count();
-  if (!c.pending.empty() && (blocked > opt_.send_timeout || c.pending.size() > kMaxPayload * 16)) {
+  if (blocked > opt_.send_timeout || c.queued_bytes > kMaxQueued) {
     {
       std::lock_guard<std::mutex> lock(stats_mutex_);
       ++stats_.dropped_clients;
@@ -138,7 +150,7 @@ void NavtechServer::drain() {
     bool pending = false;
     for (auto& c : clients_) {
       flush(*c);
-      pending = pending || (c->fd >= 0 && !c->pending.empty());
+      pending = pending || (c->fd >= 0 && !c->queue.empty());
     }
     if (!pending || !running_ || Clock::now() >= until) return;
     waitForEvents(20);
@@ -151,17 +163,17 @@ bool NavtechServer::anyStarted() const {
   return false;
 }
 
-bool NavtechServer::backlogged() const {
+bool NavtechServer::allCaughtUp() const {
   for (auto& c : clients_)
-    if (c->fd >= 0 && c->started && c->pending.size() > 65536) return true;
-  return false;
+    if (c->fd >= 0 && c->started && !c->queue.empty()) return false;
+  return true;
 }
 
 void NavtechServer::waitForEvents(int timeout_ms) {
   std::vector<pollfd> fds;
   if (listen_fd_ >= 0) fds.push_back({listen_fd_, POLLIN, 0});
   for (auto& c : clients_)
-    if (c->fd >= 0) fds.push_back({c->fd, short(POLLIN | (c->pending.empty() ? 0 : POLLOUT)), 0});
+    if (c->fd >= 0) fds.push_back({c->fd, short(POLLIN | (c->queue.empty() ? 0 : POLLOUT)), 0});
   if (fds.empty())
     std::this_thread::sleep_for(std::chrono::milliseconds(timeout_ms));
   else

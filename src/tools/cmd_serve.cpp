@@ -42,6 +42,7 @@ struct ServeOptions {
   std::string time_order = "little";
   uint64_t seed = 1;
   int max_clients = spinradar::navtech::ServerOptions{}.max_clients;
+  int encoder_phase = 0;
 };
 
 void serve(const ServeOptions& o) {
@@ -57,6 +58,12 @@ void serve(const ServeOptions& o) {
   so.bit_depth = o.bit_depth;
   so.wall_clock = !o.sim_clock;
   so.max_clients = o.max_clients;
+  so.encoder_phase = o.encoder_phase;
+  const int step = sim->sensor().encoder_size / std::max(1, sim->sensor().azimuths);
+  if (o.encoder_phase >= step)
+    throw std::invalid_argument("--encoder-phase " + std::to_string(o.encoder_phase) +
+                                ": must be below one azimuth step (" + std::to_string(step) +
+                                " counts)");
   so.time_order = navtech::parseTimeByteOrder(o.time_order);
   if (so.time_order == navtech::TimeByteOrder::Auto) so.time_order = navtech::TimeByteOrder::Little;
   navtech::NavtechServer server(so, sim::simScanSource(sim, 0, o.loop));
@@ -116,6 +123,10 @@ SPINRADAR_COMMAND("serve", "Serve a simulated scene as a live Navtech radar (TCP
                     app.add_option("--max-clients", o->max_clients,
                                    "Clients streamed to at once, each with its own start/stop; one more is refused (log line)")
                         ->check(CLI::Range(1, 64))
+                        ->capture_default_str();
+                    app.add_option("--encoder-phase", o->encoder_phase,
+                                   "Counts added to reported encoder values, below one step (a real CIR204-H: 13)")
+                        ->check(CLI::NonNegativeNumber)
                         ->capture_default_str();
                     app.callback([o] { serve(*o); });
                   });

@@ -20,7 +20,9 @@ if [[ -z "$py" ]]; then
   exit 1
 fi
 mkdir -p "$out"
-"$cli" serve --scene city --port 0 --rate 1 > "$out/serve.log" 2>&1 &
+# Encoders at a real CIR204-H's phase (13, 27, ..., 5599): the example turns them into rows with
+# int(), which with phase 0 puts 18 of the 400 rows one row down (float truncation).
+"$cli" serve --scene city --port 0 --rate 1 --encoder-phase 13 > "$out/serve.log" 2>&1 &
 serve_pid=$!
 trap 'kill "$serve_pid" 2>/dev/null; wait "$serve_pid" 2>/dev/null' EXIT
 port=""

@@ -16,7 +16,7 @@ example, host, port = sys.argv[1], sys.argv[2], int(sys.argv[3])
 SIGNATURE = bytes([0x00, 0x01, 0x03, 0x03, 0x07, 0x07, 0x0F, 0x0F,
                    0x1F, 0x1F, 0x3F, 0x3F, 0x7F, 0x7F, 0xFE, 0xFE])
 namespace = {"__name__": "__main__", "__file__": example}
-wire = {"buf": bytearray(), "types": {}, "encoders": set(), "versions": set()}
+wire = {"buf": bytearray(), "types": {}, "encoders": set(), "versions": set(), "zero_rows": set()}
 assembled = []
 
 
@@ -58,8 +58,11 @@ def count_messages(data):
         mtype = buf[17]
         wire["versions"].add(buf[16])
         wire["types"][mtype] = wire["types"].get(mtype, 0) + 1
-        if mtype in (30, 31) and size >= 6:
-            wire["encoders"].add(int.from_bytes(buf[26:28], "big"))
+        if mtype in (30, 31) and size >= 14:
+            encoder = int.from_bytes(buf[26:28], "big")
+            wire["encoders"].add(encoder)
+            if not any(buf[22 + 14:22 + size]):
+                wire["zero_rows"].add(encoder)
         del buf[:22 + size]
 
 
@@ -89,6 +92,7 @@ print("harness: on the wire: {} configuration, {} FFT messages ({} distinct azim
       "{} keep-alives, protocol version byte(s) {}".format(
           wire["types"].get(10, 0), wire["types"].get(30, 0) + wire["types"].get(31, 0),
           len(wire["encoders"]), wire["types"].get(1, 0), sorted(wire["versions"])))
+print("harness: rows all zero on the wire: {}".format(len(wire["zero_rows"])))
 print("harness: the example read {} FFT messages; its rotation has {} of {} azimuth rows "
       "with data; {:.1f} s in all".format(captured, rows, samples, elapsed))
 if samples > 0 and rows == samples and len(wire["encoders"]) >= samples:

@@ -73,7 +73,13 @@ TEST(OdometryTimeAnomalies, SensorClockStepsThroughTheDriver) {
   so.rate = 0;
   so.wall_clock = false;  // the simulator's clock: truth times are the stamps (-10 s between)
   so.log = [](navtech::LogLevel, const std::string&) {};
-  so.faults = {{3 * 400 + 200, K::ClockStep, 10.0}, {7 * 400 + 100, K::ClockStep, -10.0}};
+  so.faults.resize(2);
+  so.faults[0].at_azimuth = 3 * 400 + 200;
+  so.faults[0].kind = K::ClockStep;
+  so.faults[0].value = 10.0;
+  so.faults[1].at_azimuth = 7 * 400 + 100;
+  so.faults[1].kind = K::ClockStep;
+  so.faults[1].value = -10.0;
   navtech::NavtechServer server(so, sim::simScanSource(citySim(), 0));
   server.start();
   DriverConfig c;

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -53,10 +54,14 @@ struct ServerOptions {
   double rate = 1.0;              ///< multiple of real time; 0 = as fast as the client reads
   double rotation_hz = 4.0;       ///< sets the configuration's rotation speed and packet rate
   int bit_depth = 8;              ///< 8: type 30 messages; 16: type 31 (value = power * 256)
+  /// Counts added to every reported encoder value, below one azimuth step (the rows are not
+  /// moved: a reported-angle offset). A real CIR204-H reports 13, 27, ..., 5599 (phase 13);
+  /// clients that turn encoders into rows with int() need a phase > 0 (Navtech's examples).
+  int encoder_phase = 0;
   TimeByteOrder time_order = TimeByteOrder::Little;
   bool wall_clock = true;         ///< sensor time = wall clock (else the source's stamps as is)
   double keep_alive_period = 1.0; ///< s
-  double send_timeout = 2.0;      ///< s a client may block a send before it is dropped
+  double send_timeout = 2.0;      ///< s a client may take nothing before it is dropped
   bool stream_without_start = false;  ///< stream FFT data even before Start FFT Data
   /// Clients served at once (the `serve --max-clients` option reads its default here). One
   /// more is accepted, logged as refused and closed at once, so it is never left hanging.
@@ -97,8 +102,10 @@ class NavtechServer {
     StreamParser commands;
     bool started = false;
     bool version_logged = false;
-    std::vector<uint8_t> pending;  ///< bytes its socket did not take yet
-    std::chrono::steady_clock::time_point blocked_since{};
+    std::deque<std::vector<uint8_t>> queue;  ///< whole messages not handed to the kernel yet
+    size_t head_sent = 0;                    ///< bytes of queue.front() already handed over
+    size_t queued_bytes = 0;
+    std::chrono::steady_clock::time_point blocked_since{};  ///< last progress
   };
 
   void run();
@@ -110,10 +117,11 @@ class NavtechServer {
   void send(Client& c, const uint8_t* data, size_t n);
   void flush(Client& c);
   void broadcast(const uint8_t* data, size_t n, bool started_only);
+  int unsent(const Client& c) const;  ///< bytes the kernel holds unsent (window-limited)
   void drain();  ///< sends what is pending (at most send_timeout), e.g. before closing
   void sendConfiguration(Client& c);
   bool anyStarted() const;
-  bool backlogged() const;
+  bool allCaughtUp() const;  ///< no started client has messages waiting
   void waitForEvents(int timeout_ms);
   bool sendAzimuth();
   bool nextAzimuth();  ///< encodes the next azimuth into out_ and advances; false at the end
@@ -123,6 +131,7 @@ class NavtechServer {
   void sleepFor(double s);
   void log(LogLevel l, const std::string& m) const;
 
+  static constexpr size_t kMaxQueued = 16u << 20;  ///< a client further behind is dropped
   ServerOptions opt_;
   ScanSource source_;
   Configuration config_;
