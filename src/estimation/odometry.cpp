@@ -182,6 +182,7 @@ struct Odometry::Impl {
     has_last = false;
     refined.reset();
     keyframe.reset();
+    surface.reset();
   }
 
   /// Estimation and compounding on cur (prev is the previous scan, when there is one).
