@@ -8,6 +8,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <new>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +21,7 @@
 #include "spinradar/features/feature_extractor.hpp"
 #include "spinradar/features/matcher.hpp"
 #include "spinradar/io/scan_folder.hpp"
+#include "../../src/features/matcher_kernels.hpp"  // every matcher kernel on real descriptors
 
 using namespace spinradar;
 using spinradar::test::Target;
@@ -180,6 +182,44 @@ TEST(FeatureExtractor, RealOxfordScansMatchTheDatasetOdometry) {
               100 * agree);
   EXPECT_GT(m.size(), 100u);
   EXPECT_GT(agree, 0.5);
+
+  // Every matcher kernel gives the same matches as a plain double loop on real descriptors.
+  for (const auto& [a, b] : {std::pair{0, 1}, std::pair{1, 2}, std::pair{2, 0}}) {
+    const cv::Mat &d1 = frames[a].descriptors, &d2 = frames[b].descriptors;
+    std::vector<Match> ref;
+    for (int i = 0; i < d1.rows; ++i) {
+      int best = 1 << 30, second = 1 << 30, j_best = -1;
+      for (int j = 0; j < d2.rows; ++j) {
+        int d = 0;
+        for (int w = 0; w < 4; ++w) {
+          uint64_t x, y;
+          std::memcpy(&x, d1.ptr<uint8_t>(i) + 8 * w, 8);
+          std::memcpy(&y, d2.ptr<uint8_t>(j) + 8 * w, 8);
+          d += __builtin_popcountll(x ^ y);
+        }
+        if (d < best) second = best, best = d, j_best = j;
+        else if (d < second) second = d;
+      }
+      if (best < 0.8 * second) ref.push_back({i, j_best, float(best)});
+    }
+    auto same = [&](const std::vector<Match>& got, const char* kernel) {
+      ASSERT_EQ(got.size(), ref.size()) << kernel;
+      for (size_t k = 0; k < ref.size(); ++k) {
+        EXPECT_EQ(got[k].i1, ref[k].i1) << kernel;
+        EXPECT_EQ(got[k].i2, ref[k].i2) << kernel;
+        EXPECT_EQ(got[k].distance, ref[k].distance) << kernel;
+      }
+    };
+    matchDescriptors(d1, d2, 0.8, m);
+    same(m, "chosen");
+    m.clear();
+    detail::matchScalar(d1, d2, 0.8, m);
+    same(m, "scalar");
+    m.clear();
+    if (detail::matchAvx2(d1, d2, 0.8, m)) same(m, "avx2");
+    m.clear();
+    if (detail::matchAvx512(d1, d2, 0.8, m)) same(m, "avx512");
+  }
 }
 
 TEST(FeatureExtractor, HotPathsDoNotAllocateAfterWarmUp) {

@@ -74,7 +74,7 @@ TEST(Matcher, FindsPlantedPairsAndAgreesWithNaive) {
   std::vector<Match> k;
   detail::matchScalar(d1, d2, 0.8, k);
   expectSame(k, naive(d1, d2, 0.8));
-  for (int rows : {1, 7, 8, 9, 64, 353}) {  // block tails of the 8-row kernel
+  for (int rows : {1, 2, 7, 8, 9, 15, 16, 17, 24, 64, 353}) {  // block tails (8 rows, pairs of 16)
     const cv::Mat sub = d2.rowRange(0, rows);
     k.clear();
     if (detail::matchAvx2(d1, sub, 0.8, k)) {
@@ -86,6 +86,12 @@ TEST(Matcher, FindsPlantedPairsAndAgreesWithNaive) {
     } else if (rows == 1) {
       std::printf("no AVX-512 VPOPCNTDQ on this CPU: only the portable kernel is tested\n");
     }
+  }
+  // Query groups of every size (the AVX-512 kernel takes six queries a pass).
+  for (int queries : {1, 5, 6, 7, 13}) {
+    const cv::Mat sub = d1.rowRange(0, queries);
+    k.clear();
+    if (detail::matchAvx512(sub, d2, 0.8, k)) expectSame(k, naive(sub, d2, 0.8));
   }
   // Other widths take the generic path.
   const cv::Mat g1 = randomDescriptors(37, 61, rng), g2 = randomDescriptors(45, 61, rng);
