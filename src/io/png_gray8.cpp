@@ -1,6 +1,11 @@
 // Fast 8-bit grayscale PNG decoding (see include/spinradar/io/png_gray8.hpp).
 #include "spinradar/io/png_gray8.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -141,22 +146,30 @@ const char* pngDecoderName(PngDecoder decoder) {
 }
 
 void readFileBytes(const std::string& path, std::vector<uint8_t>& bytes) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) throw std::runtime_error(path + ": cannot open file");
-  // Read straight into the reused buffer (size from the file's end), then whatever remains.
+  // POSIX calls rather than stdio: fopen allocates a FILE and its buffer on every call, and the
+  // scan loader must not allocate per scan once warmed up.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw std::runtime_error(path + ": cannot open file");
+  struct stat st {};
   size_t n = 0;
-  if (std::fseek(f, 0, SEEK_END) == 0) {
-    const long end = std::ftell(f);
-    n = end > 0 ? size_t(end) : 0;
-    std::fseek(f, 0, SEEK_SET);
+  if (::fstat(fd, &st) == 0 && st.st_size > 0) n = size_t(st.st_size);
+  bytes.resize(n);  // read straight into the reused buffer, then whatever the size missed
+  size_t got = 0;
+  bool failed = false;
+  uint8_t more[4096];
+  for (;;) {
+    const bool room = got < bytes.size();
+    const ssize_t r = room ? ::read(fd, bytes.data() + got, bytes.size() - got) : ::read(fd, more, sizeof more);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) {
+      failed = r < 0;
+      break;
+    }
+    if (!room) bytes.insert(bytes.end(), more, more + r);  // the file grew since fstat
+    got += size_t(r);
   }
-  bytes.resize(n);
-  size_t got = n ? std::fread(bytes.data(), 1, n, f) : 0;
+  ::close(fd);
   bytes.resize(got);
-  uint8_t buf[4096];
-  while ((got = std::fread(buf, 1, sizeof buf, f)) > 0) bytes.insert(bytes.end(), buf, buf + got);
-  const bool failed = std::ferror(f) != 0;
-  std::fclose(f);
   if (failed) throw std::runtime_error(path + ": read error");
 }
 

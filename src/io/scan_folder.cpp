@@ -277,14 +277,19 @@ ScanFolder::ScanFolder(const std::string& folder, ScanFormat format, ScanFolderO
 }
 
 PolarScan ScanFolder::load(size_t i) const {
-  const File& f = files_.at(i);
   PolarScan s;
+  load(i, s);
+  return s;
+}
+
+void ScanFolder::load(size_t i, PolarScan& s) const {
+  const File& f = files_.at(i);
   switch (format_) {
     case ScanFormat::Oxford:
-      s = loadOxfordPng(f.path, options_.range_resolution.value_or(0.0438), options_.range_offset.value_or(0.0));
+      loadOxfordPng(f.path, s, options_.range_resolution.value_or(0.0438), options_.range_offset.value_or(0.0));
       break;
     case ScanFormat::Boreas:
-      s = loadBoreasPng(f.path, options_.range_offset.value_or(kBoreasRangeOffset));
+      loadBoreasPng(f.path, s, options_.range_offset.value_or(kBoreasRangeOffset));
       if (options_.range_resolution) s.range_resolution = *options_.range_resolution;
       break;
     case ScanFormat::MulRan:
@@ -307,7 +312,6 @@ PolarScan ScanFolder::load(size_t i) const {
         << ")";
     throw std::runtime_error(m.str());
   }
-  return s;
 }
 
 }  // namespace spinradar

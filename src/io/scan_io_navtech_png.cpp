@@ -44,8 +44,9 @@ bool looksLikeChirpColumn(const cv::Mat& img) {
   return mixed == 0 && flips >= (img.rows - 1) * 9 / 10;
 }
 
-PolarScan decodeRows(const cv::Mat& img, const std::string& name, double resolution,
-                     double offset, Column10 col10) {
+/// Fills `scan` from the image, reusing its buffers (no allocation once it held a scan of this size).
+void decodeRows(const cv::Mat& img, const std::string& name, double resolution, double offset,
+                Column10 col10, PolarScan& scan) {
   if (img.empty()) throw std::runtime_error(name + ": empty image");
   if (img.depth() != CV_8U || img.channels() != 1) {
     std::ostringstream s;
@@ -59,13 +60,15 @@ PolarScan decodeRows(const cv::Mat& img, const std::string& name, double resolut
       << " metadata columns + at least 1 bin expected";
     throw std::runtime_error(s.str());
   }
-  PolarScan scan;
   scan.resize(img.rows, img.cols - kNavtechMetaColumns);
   scan.range_resolution = resolution;
   scan.range_offset = offset;
   scan.encoder_size = 5600;
   const bool chirp = col10 == Column10::BoreasAuto && looksLikeChirpColumn(img);
-  if (chirp) scan.chirp_up.assign(img.rows, 0);
+  if (chirp)
+    scan.chirp_up.assign(img.rows, 0);
+  else
+    scan.chirp_up.clear();  // a reused scan may hold a previous file's
   const double two_pi = 2.0 * M_PI;
   for (int a = 0; a < img.rows; ++a) {
     const uint8_t* p = img.ptr<uint8_t>(a);
@@ -95,7 +98,6 @@ PolarScan decodeRows(const cv::Mat& img, const std::string& name, double resolut
     std::memcpy(scan.row(a), p + kNavtechMetaColumns, scan.bins);
   }
   detail::markMissingAndDuplicates(scan, name);
-  return scan;
 }
 
 /// The returned image points into this thread's decoder buffer: use it before the next call.
@@ -158,7 +160,9 @@ void scanWarning(const std::string& message) {
 
 PolarScan decodeOxfordImage(const cv::Mat& image, const std::string& name,
                             double range_resolution, double range_offset) {
-  return decodeRows(image, name, range_resolution, range_offset, Column10::Valid);
+  PolarScan scan;
+  decodeRows(image, name, range_resolution, range_offset, Column10::Valid, scan);
+  return scan;
 }
 
 void encodeOxfordImage(const PolarScan& scan, cv::Mat& image) { encodeRows(scan, image, false); }
@@ -171,9 +175,15 @@ void checkRowsShape(const cv::Mat& img, const std::string& path, const char* for
 }
 
 PolarScan loadOxfordPng(const std::string& path, double range_resolution, double range_offset) {
+  PolarScan scan;
+  loadOxfordPng(path, scan, range_resolution, range_offset);
+  return scan;
+}
+
+void loadOxfordPng(const std::string& path, PolarScan& scan, double range_resolution, double range_offset) {
   const cv::Mat img = readGray(path);
   checkRowsShape(img, path, "Oxford");
-  return decodeRows(img, path, range_resolution, range_offset, Column10::Valid);
+  decodeRows(img, path, range_resolution, range_offset, Column10::Valid, scan);
 }
 
 void saveOxfordPng(const PolarScan& scan, const std::string& path) {
@@ -187,6 +197,12 @@ void saveOxfordPng(const PolarScan& scan, const std::string& path) {
 }
 
 PolarScan loadBoreasPng(const std::string& path, double range_offset) {
+  PolarScan scan;
+  loadBoreasPng(path, scan, range_offset);
+  return scan;
+}
+
+void loadBoreasPng(const std::string& path, PolarScan& scan, double range_offset) {
   const cv::Mat img = readGray(path);
   checkRowsShape(img, path, "Boreas");
   const int bins = img.cols - kNavtechMetaColumns;
@@ -201,10 +217,9 @@ PolarScan loadBoreasPng(const std::string& path, double range_offset) {
       << kNavtechMetaColumns << " + 6848 bins expected (Boreas layout)";
     throw std::runtime_error(s.str());
   }
-  PolarScan scan = decodeRows(img, path, res, range_offset, Column10::BoreasAuto);
+  decodeRows(img, path, res, range_offset, Column10::BoreasAuto, scan);
   if (bins == 3360 && !scan.stamp_ns.empty() && scan.stamp_ns.front() / 1000 > kBoreasUpgradeUs)
     scan.range_resolution = 0.04381;  // same width, finer bins after the upgrade (pyboreas)
-  return scan;
 }
 
 void saveBoreasPng(const PolarScan& scan, const std::string& path) {

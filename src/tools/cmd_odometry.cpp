@@ -3,7 +3,6 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
-#include <deque>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -39,7 +38,8 @@ struct OdometryArgs {
 /// Loads a folder's scans in order on one background thread, up to `depth` scans ahead of the
 /// consumer, so that decoding the next scans overlaps processing the current one. take() hands
 /// them out in order; a scan that failed to load rethrows its error there, at its own index,
-/// as the single-thread loop would.
+/// as the single-thread loop would. The scans live in a fixed ring of depth + 1 slots, each
+/// loaded into again once the consumer release()s it: no allocation per scan after warm-up.
 class ScanPrefetcher {
  public:
   struct Loaded {
@@ -47,8 +47,19 @@ class ScanPrefetcher {
     double load_ms = 0;
     std::string error;  ///< why the scan could not be read ("" when it was)
   };
+  /// Loads scan i of `folder` into `l`, reusing its buffers, and times it.
+  static void loadInto(const ScanFolder& folder, size_t i, Loaded& l) {
+    const auto t0 = std::chrono::steady_clock::now();
+    l.error.clear();
+    try {
+      folder.load(i, l.scan);
+    } catch (const std::exception& e) {
+      l.error = e.what();  // the consumer warns and skips it
+    }
+    l.load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
   ScanPrefetcher(const ScanFolder& folder, size_t depth)
-      : folder_(folder), depth_(std::max<size_t>(1, depth)), thread_([this] { loop(); }) {}
+      : folder_(folder), slots_(std::max<size_t>(1, depth) + 1), thread_([this] { loop(); }) {}
   ~ScanPrefetcher() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -58,16 +69,24 @@ class ScanPrefetcher {
     thread_.join();
   }
   /// The next scan in folder order and its load time (ms); `wait_ms` += time spent waiting.
-  Loaded take(double& wait_ms) {
+  /// Valid until release(), which must be called before the next take().
+  Loaded& take(double& wait_ms) {
     const auto t0 = std::chrono::steady_clock::now();
     std::unique_lock<std::mutex> lock(mutex_);
-    cv_.wait(lock, [this] { return !ready_.empty(); });
-    Loaded item = std::move(ready_.front());
-    ready_.pop_front();
+    cv_.wait(lock, [this] { return loaded_ > taken_; });
+    Loaded& item = slots_[taken_ % slots_.size()];
+    ++taken_;
     lock.unlock();
-    cv_.notify_all();
     wait_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return item;
+  }
+  /// Gives the slot of the last take() back to the loader.
+  void release() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      released_ = taken_;
+    }
+    cv_.notify_all();
   }
 
  private:
@@ -75,30 +94,25 @@ class ScanPrefetcher {
     for (size_t i = 0; i < folder_.size(); ++i) {
       {
         std::unique_lock<std::mutex> lock(mutex_);
-        cv_.wait(lock, [this] { return stop_ || ready_.size() < depth_; });
+        cv_.wait(lock, [this, i] { return stop_ || i < released_ + slots_.size(); });  // slot i is free
         if (stop_) return;
       }
-      Loaded item;
-      const auto t0 = std::chrono::steady_clock::now();
-      try {
-        item.scan = folder_.load(i);
-      } catch (const std::exception& e) {
-        item.error = e.what();  // the consumer warns and skips it
-      }
-      item.load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      loadInto(folder_, i, slots_[i % slots_.size()]);  // outside the lock: the consumer may work meanwhile
       {
         std::lock_guard<std::mutex> lock(mutex_);
-        ready_.push_back(std::move(item));
+        loaded_ = i + 1;
       }
       cv_.notify_all();
     }
   }
 
   const ScanFolder& folder_;
-  const size_t depth_;
+  std::vector<Loaded> slots_;
   std::mutex mutex_;
   std::condition_variable cv_;
-  std::deque<Loaded> ready_;
+  size_t loaded_ = 0;    ///< scans [0, loaded_) are in their slots
+  size_t taken_ = 0;     ///< handed to the consumer
+  size_t released_ = 0;  ///< given back: their slots may be loaded into again
   bool stop_ = false;
   std::thread thread_;  // last: starts once the members above exist
 };
@@ -171,18 +185,6 @@ void run(OdometryArgs& a) {
   double load_ms = 0;
   size_t failures = 0;
   const auto wall0 = std::chrono::steady_clock::now();
-  auto timedLoad = [&folder](size_t i) {
-    ScanPrefetcher::Loaded l;
-    const auto t0 = std::chrono::steady_clock::now();
-    try {
-      l.scan = folder.load(i);
-    } catch (const std::exception& e) {
-      l.error = e.what();
-    }
-    l.load_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    return l;
-  };
   // A scan that cannot be read is skipped with a warning naming it (a long recording is still
   // worth its other scans); the run stops when the first three all fail or none can be read.
   size_t skipped = 0, processed = 0;
@@ -192,8 +194,17 @@ void run(OdometryArgs& a) {
   double wait_ms = 0;
   std::optional<ScanPrefetcher> prefetcher;
   if (prefetch) prefetcher.emplace(folder, 3);
+  ScanPrefetcher::Loaded single;  // one thread: every scan is loaded into this one, reused
+  struct ReleaseSlot {  // hands the prefetcher's slot back at the end of each iteration
+    ScanPrefetcher* p;
+    ~ReleaseSlot() {
+      if (p) p->release();
+    }
+  };
   for (size_t i = 0; i < folder.size(); ++i) {
-    ScanPrefetcher::Loaded l = prefetch ? prefetcher->take(wait_ms) : timedLoad(i);
+    if (!prefetch) ScanPrefetcher::loadInto(folder, i, single);
+    ScanPrefetcher::Loaded& l = prefetch ? prefetcher->take(wait_ms) : single;
+    const ReleaseSlot release{prefetch ? &*prefetcher : nullptr};
     load_ms += l.load_ms;
     if (!l.error.empty()) {
       ++skipped;

@@ -41,6 +41,11 @@ class ScanFolder {
   /// Loads scan i with the folder's format and options. Throws std::runtime_error naming the
   /// file when it cannot be read or its bin count differs from the folder's first scan.
   PolarScan load(size_t i) const;
+  /// Loads scan i into `scan`, reusing its buffers: Oxford and Boreas PNGs allocate nothing once
+  /// `scan` has held a scan of the same size (MulRan CSVs and RADIATE PNGs are read into a new
+  /// scan, moved in). Same checks and errors as load(i); after an error `scan` holds unspecified
+  /// contents (still fine to load into again).
+  void load(size_t i, PolarScan& scan) const;
   /// Range bins of the folder's first scan (from its header), 0 when unknown.
   int expectedBins() const { return expected_bins_; }
 

@@ -32,6 +32,12 @@ void scanWarning(const std::string& message);
 // ---- Oxford Radar RobotCar ----
 PolarScan loadOxfordPng(const std::string& path, double range_resolution = 0.0438,
                         double range_offset = 0.0);
+/// The same into an existing scan, reusing its buffers: once `scan` has held a scan of this
+/// size, loading allocates nothing (the file bytes and the decoder's buffers are per thread and
+/// reused too). Every field of `scan` is overwritten; after an exception its contents are
+/// unspecified (but valid to load into again).
+void loadOxfordPng(const std::string& path, PolarScan& scan, double range_resolution = 0.0438,
+                   double range_offset = 0.0);
 /// Writes the Oxford layout (column 10 = 255 for valid rows, 0 otherwise). Stamps are written in
 /// microseconds (truncated). Throws std::runtime_error naming the file when it cannot be written.
 void saveOxfordPng(const PolarScan& scan, const std::string& path);
@@ -49,6 +55,8 @@ void encodeOxfordImage(const PolarScan& scan, cv::Mat& image);
 constexpr double kBoreasRangeOffset = -0.31;
 constexpr int64_t kBoreasUpgradeUs = 1632182400LL * 1000000;  ///< 2021-09-21 00:00 UTC
 PolarScan loadBoreasPng(const std::string& path, double range_offset = kBoreasRangeOffset);
+/// Into an existing scan, reusing its buffers (as loadOxfordPng above).
+void loadBoreasPng(const std::string& path, PolarScan& scan, double range_offset = kBoreasRangeOffset);
 /// Column 10 = chirp_up ? 255 : 0 when chirp_up is present, else 255/0 valid flag.
 void saveBoreasPng(const PolarScan& scan, const std::string& path);
 /// Boreas names a scan file after the stamp of its middle azimuth (microseconds).
