@@ -67,6 +67,7 @@ cols_spec=(
   "city_noise14|city|0|{\"noise_floor_db\": 14.0}|1|no"
   "city_clutter4x|city|0|{}|4|no"
   "tight_turns|tight_turns|0|{}|1|no"
+  "out_and_back_v2|out_and_back|2|{}|1|no"
   "city_v5_narrow_beam2.4|city|5|{\"range_psf_sigma_bins\": 0.64, \"beam_width_deg\": 2.4}|1|yes"
   "out_and_back|out_and_back|0|{}|1|yes"
 )
