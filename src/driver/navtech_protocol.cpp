@@ -212,7 +212,8 @@ bool StreamParser::next(RawMessage& out) {
     const size_t avail = buf_.size() - pos_;
     const uint8_t* p = buf_.data() + pos_;
     const size_t cmp = avail < kSignature.size() ? avail : kSignature.size();
-    if (std::memcmp(p, kSignature.data(), cmp) != 0) {
+    // cmp == 0 on an empty buffer, where p may be null (memcmp's arguments must not be).
+    if (cmp != 0 && std::memcmp(p, kSignature.data(), cmp) != 0) {
       const size_t s = findSignature(pos_ + 1, buf_.size());
       if (s == buf_.size()) {
         // Keep a tail that may be the start of a signature split across reads.

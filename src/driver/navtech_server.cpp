@@ -175,10 +175,17 @@ bool NavtechServer::applyFaults() {
 }
 
 bool NavtechServer::nextAzimuth() {
-  if (row_ >= scan_.azimuths && !nextScan()) return false;
+  // The source's scan is resampled when the configuration differs from it (after a fault);
+  // row_ then counts configuration rows. A configuration change mid-scan can leave row_ past
+  // the new row count, which ends that scan.
+  auto sameShape = [this] {
+    return config_.azimuth_samples == scan_.azimuths && config_.range_in_bins == scan_.bins;
+  };
+  if (row_ >= (sameShape() ? scan_.azimuths : int(config_.azimuth_samples)) && !nextScan())
+    return false;
   const int n = config_.azimuth_samples, nb = config_.range_in_bins;
-  // The source's scan is resampled when the configuration differs from it (after a fault).
-  const bool same = n == scan_.azimuths && nb == scan_.bins;
+  const bool same = sameShape();
+  if (!same && row_ >= n) return false;  // a configuration of 0 rows: nothing to send
   const int src_row = same ? row_ : int(int64_t(row_) * scan_.azimuths / n);
   const uint16_t encoder = uint16_t(
       ((same ? scan_.encoder[row_] : int64_t(row_) * config_.encoder_size / n) + opt_.encoder_phase) %
@@ -198,8 +205,7 @@ bool NavtechServer::nextAzimuth() {
     encodeFft8(out_, sweep_, encoder, stamp, bins8_.data(), bins8_.size(), opt_.time_order);
   }
   ++sweep_;
-  // When the configuration has more rows than the scan, rows advance in configuration units.
-  row_ = same ? row_ + 1 : (row_ + 1 >= n ? scan_.azimuths : row_ + 1);
+  ++row_;
   return true;
 }
 

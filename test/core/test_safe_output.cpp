@@ -9,6 +9,7 @@
 #include <limits>
 #include <sstream>
 
+#include "support/temp_dir.hpp"
 #include "spinradar/core/checked_int.hpp"
 #include "spinradar/core/param_check.hpp"
 #include "spinradar/core/safe_output.hpp"
@@ -16,25 +17,9 @@
 using namespace spinradar;
 namespace fs = std::filesystem;
 
-namespace {
+using spinradar::test::TempDir;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int n = 0;
-    path = fs::temp_directory_path() /
-           ("spinradar_safe_output_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-  size_t entries() const {
-    return static_cast<size_t>(std::distance(fs::directory_iterator(path), fs::directory_iterator()));
-  }
-};
+namespace {
 
 std::string readAll(const std::string& path) {
   std::ifstream f(path);

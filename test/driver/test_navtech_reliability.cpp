@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <functional>
 #include <thread>
 
 #include "navtech_test_util.hpp"
@@ -59,14 +60,32 @@ ServerFault fault(uint64_t at, ServerFault::Kind kind, double value = 0) {
   return f;
 }
 
+/// The emulator (started, with its scripted faults) and a driver connected to it, logging
+/// into `log`; `tune` adjusts the driver's configuration.
+struct Rig {
+  NavtechServer server;
+  NavtechDriver d;
+  LogSink log;
+  explicit Rig(ServerOptions o, ScanSource source = patternSource(),
+               const std::function<void(DriverConfig&)>& tune = {})
+      : server(std::move(o), std::move(source)), d(startAndConfigure(server, tune)) {
+    d.setLog(log.fn());
+  }
+  static DriverConfig startAndConfigure(NavtechServer& s,
+                                        const std::function<void(DriverConfig&)>& tune) {
+    s.start();
+    DriverConfig c = fastDriverConfig(s.port());
+    if (tune) tune(c);
+    return c;
+  }
+};
+
 }  // namespace
 
 TEST(NavtechReliability, CleanStream) {
-  NavtechServer server(serverOptions(), patternSource());
-  server.start();
-  NavtechDriver d(fastDriverConfig(server.port()));
-  LogSink log;
-  d.setLog(log.fn());
+  Rig rig(serverOptions());
+  NavtechDriver& d = rig.d;
+  LogSink& log = rig.log;
   PollResult r = pollScans(d, 4, 10);
   ASSERT_EQ(r.scans.size(), 4u) << log.all();
   for (auto& s : r.scans) {
@@ -105,13 +124,10 @@ TEST(NavtechReliability, SensorNotUpAtStartThenComesUp) {
 }
 
 TEST(NavtechReliability, DisconnectMidRotationReconnects) {
-  NavtechServer server(serverOptions({fault(600, ServerFault::Kind::Disconnect),
-                                      fault(1500, ServerFault::Kind::Disconnect)}),
-                       patternSource());
-  server.start();
-  NavtechDriver d(fastDriverConfig(server.port()));
-  LogSink log;
-  d.setLog(log.fn());
+  Rig rig(serverOptions({fault(600, ServerFault::Kind::Disconnect),
+                         fault(1500, ServerFault::Kind::Disconnect)}));
+  NavtechDriver& d = rig.d;
+  LogSink& log = rig.log;
   PollResult r = pollScans(d, 5, 15);
   EXPECT_EQ(r.scans.size(), 5u) << log.all();
   EXPECT_EQ(r.disconnects, 2);
@@ -130,11 +146,9 @@ TEST(NavtechReliability, RestartWithNewConfiguration) {
   f.config.bin_size = 596;
   f.config.rotation_mhz = 4000;
   f.config.packet_rate = 800;
-  NavtechServer server(serverOptions({f}), patternSource());
-  server.start();
-  NavtechDriver d(fastDriverConfig(server.port()));
-  LogSink log;
-  d.setLog(log.fn());
+  Rig rig(serverOptions({f}));
+  NavtechDriver& d = rig.d;
+  LogSink& log = rig.log;
   PollResult r = pollScans(d, 4, 15);
   ASSERT_EQ(r.scans.size(), 4u) << log.all();
   EXPECT_EQ(r.scans.front().scan.bins, 64);
@@ -150,11 +164,9 @@ TEST(NavtechReliability, NewConfigurationMidStream) {
   f.config.azimuth_samples = 400;
   f.config.encoder_size = 5600;
   f.config.range_in_bins = 32;
-  NavtechServer server(serverOptions({f}), patternSource());
-  server.start();
-  NavtechDriver d(fastDriverConfig(server.port()));
-  LogSink log;
-  d.setLog(log.fn());
+  Rig rig(serverOptions({f}));
+  NavtechDriver& d = rig.d;
+  LogSink& log = rig.log;
   PollResult r = pollScans(d, 4, 15);
   ASSERT_EQ(r.scans.size(), 4u) << log.all();
   EXPECT_EQ(r.scans.back().scan.bins, 32);
@@ -163,13 +175,9 @@ TEST(NavtechReliability, NewConfigurationMidStream) {
 }
 
 TEST(NavtechReliability, StalledStreamReconnects) {
-  NavtechServer server(serverOptions({fault(600, ServerFault::Kind::Stall, 1.0)}),
-                       patternSource());
-  server.start();
-  NavtechDriver d(fastDriverConfig(server.port()));  // stall_timeout 0.4 s
-  LogSink log;
-  d.setLog(log.fn());
-  PollResult r = pollScans(d, 4, 15);
+  Rig rig(serverOptions({fault(600, ServerFault::Kind::Stall, 1.0)}));  // stall_timeout 0.4 s
+  LogSink& log = rig.log;
+  PollResult r = pollScans(rig.d, 4, 15);
   EXPECT_EQ(r.scans.size(), 4u) << log.all();
   EXPECT_GE(r.disconnects, 1);
   EXPECT_TRUE(log.contains("stalled stream")) << log.all();
@@ -177,17 +185,12 @@ TEST(NavtechReliability, StalledStreamReconnects) {
 
 TEST(NavtechReliability, CorruptedBytesNeverMakeMalformedScans) {
   using K = ServerFault::Kind;
-  NavtechServer server(serverOptions({fault(450, K::Truncate), fault(900, K::CorruptSignature),
-                                      fault(1300, K::Oversized, 50e6),
-                                      fault(1700, K::Garbage, 5000), fault(1702, K::Truncate),
-                                      fault(2100, K::Oversized, 700e3)}),
-                       patternSource());
-  server.start();
-  DriverConfig c = fastDriverConfig(server.port());
-  c.min_valid_fraction = 0.9;
-  NavtechDriver d(c);
-  LogSink log;
-  d.setLog(log.fn());
+  Rig rig(serverOptions({fault(450, K::Truncate), fault(900, K::CorruptSignature),
+                         fault(1300, K::Oversized, 50e6), fault(1700, K::Garbage, 5000),
+                         fault(1702, K::Truncate), fault(2100, K::Oversized, 700e3)}),
+          patternSource(), [](DriverConfig& c) { c.min_valid_fraction = 0.9; });
+  NavtechDriver& d = rig.d;
+  LogSink& log = rig.log;
   PollResult r = pollScans(d, 6, 20);
   EXPECT_EQ(r.scans.size(), 6u) << log.all();
   const DriverStats st = d.stats();
@@ -204,11 +207,9 @@ TEST(NavtechReliability, CorruptedBytesNeverMakeMalformedScans) {
 }
 
 TEST(NavtechReliability, SlowConsumerAtTenTimesRealRate) {
-  NavtechServer server(serverOptions({}, 10.0), patternSource(400, 256));
-  server.start();
-  NavtechDriver d(fastDriverConfig(server.port()));
-  LogSink log;
-  d.setLog(log.fn());
+  Rig rig(serverOptions({}, 10.0), patternSource(400, 256));
+  NavtechDriver& d = rig.d;
+  LogSink& log = rig.log;
   // The consumer takes 150 ms per scan while the sensor makes one every 25 ms: TCP pushes
   // back, the emulator waits (or drops us), the driver must only ever return whole scans.
   PollResult r = pollScans(d, 8, 20, 150);

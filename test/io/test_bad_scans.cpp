@@ -2,7 +2,6 @@
 // format, numbers from names and rows checked, each failure naming the file and the reason.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -10,28 +9,16 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "support/temp_dir.hpp"
 #include "spinradar/io/scan_folder.hpp"
 #include "spinradar/io/scan_io.hpp"
 
 using namespace spinradar;
 namespace fs = std::filesystem;
 
-namespace {
+using spinradar::test::TempDir;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int n = 0;
-    path = fs::temp_directory_path() /
-           ("spinradar_bad_scans_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-};
+namespace {
 
 PolarScan makeScan(int azimuths, int bins, int64_t t0_us) {
   PolarScan s;

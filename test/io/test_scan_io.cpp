@@ -8,31 +8,16 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "support/temp_dir.hpp"
 #include "spinradar/io/scan_folder.hpp"
 #include "spinradar/io/scan_io.hpp"
 
 using namespace spinradar;
 namespace fs = std::filesystem;
 
-namespace {
+using spinradar::test::TempDir;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    path = fs::temp_directory_path() /
-           ("spinradar_scan_io_" + std::to_string(::getpid()) + "_" + std::to_string(counter()++));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-  static int& counter() {
-    static int c = 0;
-    return c;
-  }
-};
+namespace {
 
 PolarScan makeScan(int azimuths, int bins, int64_t t0_us, unsigned seed = 1) {
   PolarScan s;

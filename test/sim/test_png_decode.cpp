@@ -13,6 +13,7 @@
 #include <spng.h>
 
 #include "support/count_allocations.hpp"
+#include "support/temp_dir.hpp"
 #include "spinradar/io/png_gray8.hpp"
 #include "spinradar/io/png_io.hpp"
 #include "spinradar/io/scan_io.hpp"
@@ -21,6 +22,8 @@
 
 using namespace spinradar;
 namespace fs = std::filesystem;
+
+using spinradar::test::TempDir;
 
 namespace {
 
@@ -83,12 +86,6 @@ std::vector<uint8_t> encodeWithFilter(const cv::Mat& img, int filter_choice, int
   return out;
 }
 
-struct TempDir {
-  fs::path dir = fs::temp_directory_path() / ("spinradar_png_" + std::to_string(::getpid()));
-  TempDir() { fs::create_directories(dir); }
-  ~TempDir() { fs::remove_all(dir); }
-  std::string file(const std::string& n) const { return (dir / n).string(); }
-};
 
 }  // namespace
 
