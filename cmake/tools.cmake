@@ -39,13 +39,13 @@ if(SPINRADAR_TOOL_SOURCES)
   endif()
   target_compile_definitions(spinradar_cli PRIVATE SPINRADAR_IMGCODECS_SO="${_imgcodecs_so}")
   target_link_libraries(spinradar_cli PRIVATE ${CMAKE_DL_LIBS})
-  foreach(lib spinradar_bag)
-    if(TARGET ${lib})
-      target_link_libraries(spinradar_cli PRIVATE ${lib})
-    endif()
-  endforeach()
+  # spinradar_bag (and ROS with it) is loaded with dlopen by the commands that use a bag, not
+  # linked: src/tools/bag_loader.cpp. Built with the CLI; the CLI sees its header only.
   if(TARGET spinradar_bag)
-    target_compile_definitions(spinradar_cli PRIVATE SPINRADAR_HAVE_BAG=1)
+    add_dependencies(spinradar_cli spinradar_bag)
+    target_compile_definitions(spinradar_cli PRIVATE SPINRADAR_HAVE_BAG=1
+      SPINRADAR_BAG_SO_NAME="$<TARGET_FILE_NAME:spinradar_bag>"
+      SPINRADAR_BAG_SO_PATH="$<TARGET_FILE:spinradar_bag>")
   endif()
   if(TARGET spinradar_sim)
     target_compile_definitions(spinradar_cli PRIVATE SPINRADAR_HAVE_SIM=1)

@@ -147,3 +147,8 @@ size_t bagToFolder(const std::string& bag_path, const std::string& out_dir,
 }
 
 }  // namespace spinradar::bag
+
+extern "C" const spinradar::bag::BagApi* spinradar_bag_api() {
+  static const spinradar::bag::BagApi api{&spinradar::bag::folderToBag, &spinradar::bag::bagToFolder};
+  return &api;
+}
