@@ -2,12 +2,11 @@
 // scan): the same scan as a fresh load, field by field, and no heap allocation once warmed up.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <random>
 
 #include "support/count_allocations.hpp"
+#include "support/temp_dir.hpp"
 #include "spinradar/io/scan_folder.hpp"
 #include "spinradar/io/scan_io.hpp"
 
@@ -15,16 +14,6 @@ using namespace spinradar;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct TempDir {
-  fs::path path = fs::temp_directory_path() / ("spinradar_scan_reuse_" + std::to_string(::getpid()));
-  TempDir() { fs::create_directories(path); }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-};
 
 /// A full-size Oxford-like scan; scan k has its own power, stamps and a few missing rows.
 PolarScan makeScan(int k, int bins = 3768) {
@@ -60,7 +49,7 @@ void expectSameScan(const PolarScan& a, const PolarScan& b) {
 }  // namespace
 
 TEST(ScanReuse, FolderLoadIntoEqualsFreshLoadWithoutAllocating) {
-  TempDir d;
+  test::TempDir d("spinradar_scan_reuse");
   const int n = 6;
   for (int k = 0; k < n; ++k) {
     const PolarScan s = makeScan(k);
@@ -82,7 +71,7 @@ TEST(ScanReuse, FolderLoadIntoEqualsFreshLoadWithoutAllocating) {
 }
 
 TEST(ScanReuse, EveryFieldIsOverwritten) {
-  TempDir d;
+  test::TempDir d("spinradar_scan_reuse");
   // A Boreas-RT scan (chirps, 6848 bins, offset -0.31) loaded into first, then an Oxford scan:
   // nothing of the first may remain.
   PolarScan boreas = makeScan(3, 6848);
