@@ -303,4 +303,31 @@ void matchDescriptors(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::ve
     detail::matchScalar(d1, d2, nndr, out);
 }
 
+const char* matchKernelName(MatchKernel kernel) {
+  switch (kernel) {
+    case MatchKernel::Avx512: return "AVX-512 VPOPCNTDQ";
+    case MatchKernel::Avx2: return "AVX2";
+    default: return "scalar POPCNT";
+  }
+}
+
+MatchKernel matchKernelUsed() {
+  const cv::Mat one(1, 32, CV_8UC1, cv::Scalar(0));
+  std::vector<Match> out;
+  if (detail::matchAvx512(one, one, 0.8, out)) return MatchKernel::Avx512;
+  if (detail::matchAvx2(one, one, 0.8, out)) return MatchKernel::Avx2;
+  return MatchKernel::Scalar;
+}
+
+bool matchDescriptorsWith(MatchKernel kernel, const cv::Mat& d1, const cv::Mat& d2, double nndr,
+                          std::vector<Match>& out) {
+  out.clear();
+  if (d1.empty() || d2.empty() || d1.type() != CV_8UC1 || d2.type() != CV_8UC1 || d1.cols != d2.cols) return false;
+  switch (kernel) {
+    case MatchKernel::Avx512: return detail::matchAvx512(d1, d2, nndr, out);
+    case MatchKernel::Avx2: return detail::matchAvx2(d1, d2, nndr, out);
+    default: detail::matchScalar(d1, d2, nndr, out); return true;
+  }
+}
+
 }  // namespace spinradar

@@ -16,4 +16,14 @@ struct Match {
 /// `out` is cleared and filled; buffers are reused across calls.
 void matchDescriptors(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Match>& out);
 
+/// The kernels behind matchDescriptors (all give the same matches; `bench` times each).
+enum class MatchKernel { Avx512, Avx2, Scalar };
+const char* matchKernelName(MatchKernel kernel);
+/// The kernel matchDescriptors uses for 32-byte (ORB) descriptors on this CPU.
+MatchKernel matchKernelUsed();
+/// matchDescriptors with the given kernel; false (and `out` empty) when this CPU lacks it or the
+/// descriptors are not 32 bytes wide (the SIMD kernels' only width).
+bool matchDescriptorsWith(MatchKernel kernel, const cv::Mat& d1, const cv::Mat& d2, double nndr,
+                          std::vector<Match>& out);
+
 }  // namespace spinradar
