@@ -93,6 +93,11 @@ TEST(Matcher, FindsPlantedPairsAndAgreesWithNaive) {
     k.clear();
     if (detail::matchAvx512(sub, d2, 0.8, k)) expectSame(k, naive(sub, d2, 0.8));
   }
+  // The public per-kernel entry (bench): the kernel in use exists, every kernel that runs agrees.
+  EXPECT_TRUE(matchDescriptorsWith(matchKernelUsed(), d1, d2, 0.8, k));
+  for (const MatchKernel kernel : {MatchKernel::Avx512, MatchKernel::Avx2, MatchKernel::Scalar})
+    if (matchDescriptorsWith(kernel, d1, d2, 0.8, k)) expectSame(k, naive(d1, d2, 0.8));
+  EXPECT_FALSE(matchDescriptorsWith(MatchKernel::Scalar, d1, cv::Mat(), 0.8, k));
   // Other widths take the generic path.
   const cv::Mat g1 = randomDescriptors(37, 61, rng), g2 = randomDescriptors(45, 61, rng);
   matchDescriptors(g1, g2, 0.95, m);
