@@ -40,30 +40,54 @@ inline long roundHalfAway(T v) {
 
 void CartesianProjector::buildPixelGeometry() {
   // hypot and atan2 for every pixel were most of a projector's construction (~0.25 G
-  // instructions at 964 px). The grid is symmetric about the centre column: the mirrored pixel
-  // has y -> -y exactly, so the same range and the negated atan2 (glibc's atan2 and hypot are
-  // exactly symmetric in y); each is computed once for the pair, with identical tables.
+  // instructions at 964 px). The grid is symmetric about the centre row and column and about
+  // its diagonal: the eight pixels (+-x, +-y) and (+-y, +-x) have exactly the same coordinates up
+  // to sign and order, so the same range (glibc's hypot takes |x|, |y| and orders them), and
+  // angles of -theta, pi -+ theta and -+theta -+ pi/2: in 1/65536 turns, integer offsets of one
+  // code. Each octant pixel is computed once. Its code is exactly what atan2 per pixel gives
+  // unless turns * 65536 lies within 1e-6 of a rounding boundary (atan2 errs by < 1e-11 there);
+  // such pixels, and the centre, are computed directly, so the tables equal the per-pixel ones
+  // (tested for several geometries).
   pixel_range_.resize(size_t(width_) * width_);
   pixel_angle_.resize(size_t(width_) * width_);
-  auto angleCode = [](double raw) {
-    double turns = raw / (2.0 * M_PI);  // clockwise from forward
+  auto turnsCode = [](double raw) {  // turns * 65536 clockwise from forward, in [0, 65536]
+    double turns = raw / (2.0 * M_PI);
     if (turns < 0) turns += 1.0;
-    return static_cast<uint16_t>(roundHalfAway(turns * 65536.0) & 0xffff);
+    return turns * 65536.0;
   };
-  for (int v = 0; v < width_; ++v) {
+  auto angleCode = [&](double raw) { return static_cast<uint16_t>(roundHalfAway(turnsCode(raw)) & 0xffff); };
+  auto put = [&](int v, int u, float range, uint32_t code) {
+    const size_t i = size_t(v) * width_ + u;
+    pixel_range_[i] = range;
+    pixel_angle_[i] = static_cast<uint16_t>(code & 0xffff);
+  };
+  auto direct = [&](int v, int u) {
+    const double x = (centre_ - v) * resolution_, y = (centre_ - u) * resolution_;
+    put(v, u, static_cast<float>(std::hypot(x, y)), angleCode(std::atan2(-y, x)));
+  };
+  const int half = (width_ - 1) / 2;  // rows (columns) 0..half have x >= 0 (y >= 0)
+  for (int v = 0; v <= half; ++v) {
     const double x = (centre_ - v) * resolution_;
-    for (int u = 0; u <= (width_ - 1) / 2; ++u) {
-      const int um = width_ - 1 - u;  // mirror column: (centre - um) = -(centre - u)
+    const int vm = width_ - 1 - v;
+    for (int u = v; u <= half; ++u) {  // x >= y >= 0
       const double y = (centre_ - u) * resolution_;
-      const size_t i = size_t(v) * width_ + u, im = size_t(v) * width_ + um;
-      const float range = static_cast<float>(std::hypot(x, y));
-      const double raw = std::atan2(-y, x);
-      pixel_range_[i] = range;
-      pixel_angle_[i] = angleCode(raw);
-      if (um != u) {
-        pixel_range_[im] = range;
-        pixel_angle_[im] = angleCode(-raw);
+      const int um = width_ - 1 - u;
+      const double t = turnsCode(std::atan2(-y, x));
+      if ((x == 0 && y == 0) || std::abs(t - std::floor(t) - 0.5) < 1e-6) {
+        for (const auto& [a, b] : {std::pair{v, u}, {v, um}, {vm, u}, {vm, um}, {u, v}, {u, vm}, {um, v}, {um, vm}})
+          direct(a, b);
+        continue;
       }
+      const float range = static_cast<float>(std::hypot(x, y));
+      const uint32_t c = static_cast<uint32_t>(roundHalfAway(t));
+      put(v, u, range, c);               // ( x,  y)
+      put(v, um, range, 65536 - c);      // ( x, -y): -theta
+      put(vm, u, range, 32768 - c);      // (-x,  y): pi - theta
+      put(vm, um, range, 32768 + c);     // (-x, -y): pi + theta
+      put(u, v, range, 49152 - c);       // ( y,  x): -theta - pi/2
+      put(u, vm, range, c + 16384);      // ( y, -x): theta + pi/2
+      put(um, v, range, c + 49152);      // (-y,  x): theta - pi/2
+      put(um, vm, range, 16384 + 65536 - c);  // (-y, -x): pi/2 - theta
     }
   }
 }

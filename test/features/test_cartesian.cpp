@@ -161,3 +161,33 @@ TEST(Cartesian, SimdAndPortableRemapAgree) {
   portable.render(s, b);
   EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
 }
+
+TEST(Cartesian, PixelGeometryEqualsHypotAndAtan2PerPixel) {
+  // The projector computes one octant and mirrors it (exact integer offsets of the angle code);
+  // every pixel must equal the direct per-pixel computation, for even and odd widths.
+  for (const auto& [res, width] : {std::pair{0.2592, 964}, {0.2592, 965}, {0.17, 301}, {1.0, 2}, {0.5, 3},
+                                   {0.0438 * 6, 1000}, {0.1, 64}}) {
+    CartesianProjector proj(res, width);
+    const double centre = 0.5 * (width - 1);
+    const std::vector<float>& range = proj.pixelRanges();
+    const std::vector<uint16_t>& angle = proj.pixelAngles();
+    ASSERT_EQ(range.size(), size_t(width) * width);
+    ASSERT_EQ(angle.size(), size_t(width) * width);
+    int wrong = 0;
+    for (int v = 0; v < width; ++v)
+      for (int u = 0; u < width; ++u) {
+        const double x = (centre - v) * res, y = (centre - u) * res;
+        double turns = std::atan2(-y, x) / (2.0 * M_PI);
+        if (turns < 0) turns += 1.0;
+        const uint16_t code = static_cast<uint16_t>(std::lround(turns * 65536.0) & 0xffff);
+        const size_t i = size_t(v) * width + u;
+        wrong += range[i] != static_cast<float>(std::hypot(x, y)) || angle[i] != code;
+      }
+    EXPECT_EQ(wrong, 0) << "width " << width << ", resolution " << res;
+  }
+  // Sanity of the convention: forward (up) is angle 0, right a quarter turn clockwise.
+  CartesianProjector proj(1.0, 5);
+  EXPECT_EQ(proj.pixelAngles()[0 * 5 + 2], 0);      // row 0 (x = +2), centre column
+  EXPECT_EQ(proj.pixelAngles()[2 * 5 + 4], 16384);  // centre row, right column (y = -2)
+  EXPECT_FLOAT_EQ(proj.pixelRanges()[0], std::sqrt(8.0f));
+}

@@ -50,6 +50,10 @@ class CartesianProjector {
   double resolution() const { return resolution_; }
   int width() const { return width_; }
   int tableBuilds() const { return builds_; }  ///< how many times the remap tables were built
+  /// Per pixel (row-major): range (m) of its centre and clockwise angle from forward in
+  /// 1/65536 turns, from which the tables are built.
+  const std::vector<float>& pixelRanges() const { return pixel_range_; }
+  const std::vector<uint16_t>& pixelAngles() const { return pixel_angle_; }
 
  private:
   bool geometryChanged(const PolarScan& scan, double offset) const;
