@@ -62,6 +62,16 @@ printf "%-38s %8s %8s %8s %8s %8s\n" "whole process" "ms/scan" "(median)" "cpu m
 summary one_thread "spinradar, 1 thread (taskset 1 core)"
 summary two_threads "spinradar, 2 threads"
 grep -E "load|pipeline total" "$work/one_thread.log" | sed 's/^/  one-thread run, inside: /'
+# The same on the first 2 scans: splits the CPU time into a one-off part (start-up, tables, first
+# page faults) and the cost of each further scan.
+small="$work/first_2/radar"
+rm -rf "$work/first_2"; mkdir -p "$small"
+for f in $(ls "$drive/radar" | head -2); do ln -s "$drive/radar/$f" "$small/$f"; done
+run two_scans taskset -c "$core" "$bin" odometry --input "$small" --out "$work/poses_first_2.csv" --threads 1 --quiet
+best_cpu() { sort -k3 -g "$work/$1.runs" | head -1 | awk '{ print $3 }'; }
+awk -v c2="$(best_cpu two_scans)" -v cn="$(best_cpu one_thread)" -v n="$scans" 'BEGIN {
+  per = (cn - c2) / (n - 2); printf "  one thread, CPU: %.0f ms one-off (start-up, tables) + %.1f ms per scan\n",
+  1000 * (c2 - 2 * per), 1000 * per }'
 
 side_by_side() {  # NAME CMD_TEMPLATE
   local name="$1" tmpl="$2" out="$work/$1_out"

@@ -126,8 +126,10 @@ bool cpuHasAvx512Popcnt() {
 #if defined(__GNUC__) && defined(__x86_64__)
 // GCC 12's AVX-512 min/max/reduce intrinsics pass an "undefined" source register that it then
 // warns about (a false positive in its own header).
+#if !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #define SPINRADAR_AVX512 __attribute__((target("avx512f,avx512vpopcntdq,avx512bw,avx512vl")))
 
 /// Distances from one query (four 64-bit words) to the eight train rows of one SoA block.
@@ -204,7 +206,9 @@ SPINRADAR_AVX512 void match32Avx512(const cv::Mat& d1, const cv::Mat& d2, double
   }
 }
 #undef SPINRADAR_AVX512
+#if !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 bool cpuHasAvx2() {
   __builtin_cpu_init();
