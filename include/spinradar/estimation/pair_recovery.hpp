@@ -23,9 +23,25 @@
 #include "spinradar/core/feature_frame.hpp"
 #include "spinradar/core/params.hpp"
 #include "spinradar/estimation/motion_estimate.hpp"
-#include "spinradar/estimation/surface_points.hpp"
 
 namespace spinradar {
+
+/// Points binned on a dense grid over their bounding box (counting sort, buffers reused):
+/// the recovery rebuilds its map for every search candidate and looks up every point, where
+/// a sorted-key index (CellIndex) spent most of the time in binary searches.
+class DenseGrid {
+ public:
+  void build(const std::vector<Eigen::Vector2d>& pts, double cell);
+  /// Index of the nearest point within radius (<= cell) of q, or -1.
+  int nearest(const Eigen::Vector2d& q, double radius) const;
+
+ private:
+  const std::vector<Eigen::Vector2d>* pts_ = nullptr;
+  double x0_ = 0.0, y0_ = 0.0, inv_cell_ = 1.0;
+  int nx_ = 0, ny_ = 0;
+  std::vector<int> start_;  ///< per cell (row-major), then one past the end
+  std::vector<int> order_;  ///< point indices sorted by cell
+};
 
 class PairRecovery {
  public:
@@ -40,10 +56,16 @@ class PairRecovery {
 
   int lastInliers() const { return inliers_; }
 
+  /// A keypoint as used here: position, beam unit vector (REP 103), seconds after its
+  /// scan's start.
+  struct Point {
+    double x, y, ux, uy, t;
+  };
+
   static constexpr double kYawStep = 0.035;    ///< rad per scan pair, coarse search step (2 deg)
-  static constexpr double kMaxYaw = 0.7;       ///< rad per scan pair searched either side
+  static constexpr double kMaxYaw = 0.5;       ///< rad per scan pair searched either side
   static constexpr double kSearchGate = 2.0;   ///< m, counts a point as explained
-  static constexpr int kSearchPoints = 800;    ///< scan points scored per candidate (strided)
+  static constexpr int kSearchPoints = 400;    ///< scan points scored per candidate (strided)
   static constexpr int kIterations = 12;
   static constexpr int kMinInliers = 30;
   /// The search's best candidate must explain this fraction of the scored points: a scene
@@ -51,18 +73,18 @@ class PairRecovery {
   static constexpr double kMinFraction = 0.2;
 
  private:
-  /// The map: every stride-th point of f1 with velocity xi at f1's start (map_, index_).
-  void buildMap(const FeatureFrame& f1, const Eigen::Vector3d& xi, int stride);
-  /// Every stride-th point of f2 (moved with xi2, then by the step exp(dt xi1)) within
+  /// The map: every stride-th point of scan 1 with velocity xi at its start (map_, index_).
+  void buildMap(const Eigen::Vector3d& xi, int stride);
+  /// Every stride-th point of scan 2 (moved with xi2, then by the step exp(dt xi1)) within
   /// kSearchGate of the map.
-  int score(const FeatureFrame& f2, const Eigen::Vector3d& xi1, const Eigen::Vector3d& xi2,
-            double dt, int stride) const;
+  int score(const Eigen::Vector3d& xi1, const Eigen::Vector3d& xi2, double dt, int stride) const;
 
   EstimatorConfig config_;
   int inliers_ = 0;
+  std::vector<Point> p1_, p2_;        ///< the two scans' keypoints
   std::vector<Eigen::Vector2d> map_;  ///< f1's points at its start, its frame
   std::vector<int> map_idx_;          ///< their keypoint indices in f1
-  CellIndex index_;
+  DenseGrid index_;
 };
 
 }  // namespace spinradar
