@@ -34,7 +34,7 @@ Eigen::VectorXd differenceSe(const AppearanceFigures& a, const AppearanceFigures
 /// Fills rep.locate from rep.real / rep.before.
 void locateAppearance(AppearanceReport& rep);
 /// Realism figures of the recording and of the reference re-simulated before/after the fit.
-void realismBeforeAfter(const std::vector<PolarScan>& real, const AppearanceOptions& opt,
-                        AppearanceReport& rep);
+void realismBeforeAfter(const std::vector<PolarScan>& real, const std::vector<PolarScan>& holdout,
+                        const AppearanceOptions& opt, AppearanceReport& rep);
 
 }  // namespace spinradar::diagnose::detail

@@ -132,11 +132,20 @@ AppearanceFinding makeFinding(const std::string& effect, const std::string& para
 
 }  // namespace
 
-AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real, const SensorConfig& sensor,
-                                    const sim::PhysicsConfig& physics, const AppearanceOptions& opt) {
+AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
+                                    const SensorConfig& sensor, const sim::PhysicsConfig& physics,
+                                    const AppearanceOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (real.empty()) throw std::runtime_error("appearance: no scans");
+  if (recording.empty()) throw std::runtime_error("appearance: no scans");
   AppearanceReport rep;
+  // Everything is fitted on `real`, the fit part; the held-out part only checks the result.
+  std::vector<PolarScan> real, holdout;
+  if (opt.holdout)
+    splitHoldout(recording, real, holdout);
+  else
+    real = recording;
+  rep.fit_scans = int(real.size());
+  rep.holdout_scans = int(holdout.size());
   rep.base = sensor;
   rep.base_physics = physics;
   rep.real = measureAppearance(real);
@@ -331,19 +340,24 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real, const Se
     f.named = !physicsHasGhosts(physics) && z >= opt.z_min && ratio >= opt.ghost_ratio_min;
     f.verdict = f.named ? "mismatch" : (z >= opt.z_min ? "negligible" : "not significant");
     if (f.named) {
-      // Ghost level by interpolating the behind share of re-simulations with ghosts at three levels.
-      const double levels[3] = {-25.0, -15.0, -5.0};
-      double share[3];
-      for (int i = 0; i < 3; ++i) {
+      // Ghost level by interpolating the behind share of re-simulations with ghosts at levels
+      // 5 dB apart (the share grows faster than linearly with the level: a coarser grid biases
+      // the interpolated level low).
+      constexpr int kLevels = 5;
+      const double levels[kLevels] = {-25.0, -20.0, -15.0, -10.0, -5.0};
+      double share[kLevels];
+      for (int i = 0; i < kLevels; ++i) {
         sim::PhysicsConfig p = phys;
         p.extra["multipath"] = levels[i];
         share[i] = figuresOf(cur, p).behind;
+        if (i > 0) share[i] = std::max(share[i], share[i - 1]);  // monotone in the level
       }
       auto level = [&](double s) {
-        if (s <= share[1]) return levels[0] + (s - share[0]) / std::max(share[1] - share[0], 1e-9) * 10;
-        return levels[1] + (s - share[1]) / std::max(share[2] - share[1], 1e-9) * 10;
+        int i = 0;
+        while (i + 2 < kLevels && s > share[i + 1]) ++i;
+        return levels[i] + (s - share[i]) / std::max(share[i + 1] - share[i], 1e-9) * 5;
       };
-      if (rep.real.behind > share[2] + 2 * rep.real.behind_se) {
+      if (rep.real.behind > share[kLevels - 1] + 2 * rep.real.behind_se) {
         // More than the strongest ghosts give: not multipath-like (returns through or past the
         // first reflector, elevation-beam returns); left to the notes, not switched on.
         f.named = false;
@@ -352,7 +366,7 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real, const Se
         rep.notes.push_back(
             "Behind the first strong hit the recording has " + std::to_string(100 * rep.real.behind) +
             " % bright cells, more than multipath ghosts even at -5 dB give (" +
-            std::to_string(100 * share[2]) + " %): penetration or elevation-beam returns the "
+            std::to_string(100 * share[kLevels - 1]) + " %): penetration or elevation-beam returns the "
             "simulator's occlusion removes (occlusion_tolerance), not ghosts.");
       } else {
         f.value = std::clamp(level(rep.real.behind), -80.0, 0.0);
@@ -364,6 +378,20 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real, const Se
     rep.findings.push_back(f);
   }
 
+  // --- Per-band calibration: range curves on the per-band realism figures.
+  if (opt.realism && opt.curve_iterations > 0) {
+    const sim::RealismStats target = sim::computeRealism(real, "recording (fit part)");
+    std::vector<std::string> steps;
+    const SensorConfig curved = fitRangeCurves(target, cur, phys, opt, &steps);
+    rep.notes.push_back("Per-band calibration (range gain curve, return gain curve, clutter "
+                        "density curve over range): " + std::to_string(steps.size()) +
+                        " steps taken" + (steps.empty() ? "." : "; last " + steps.back() + "."));
+    if (!steps.empty()) {
+      cur = curved;
+      rep.after = figuresOf(cur, phys);
+    }
+  }
+
   std::stable_sort(rep.findings.begin(), rep.findings.end(),
                    [](const AppearanceFinding& a, const AppearanceFinding& b) {
                      if (a.named != b.named) return a.named;
@@ -373,7 +401,7 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real, const Se
   rep.fitted = cur;
   rep.fitted_physics = phys;
   detail::locateAppearance(rep);
-  if (opt.realism) detail::realismBeforeAfter(real, opt, rep);
+  if (opt.realism) detail::realismBeforeAfter(real, holdout, opt, rep);
   rep.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return rep;
 }

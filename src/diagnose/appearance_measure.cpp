@@ -14,6 +14,7 @@ struct Replicate {
   std::array<double, kBands> floor{}, mean{}, bright{}, cfar{};
   double beam = NAN, psf = NAN, behind = NAN;
   int peaks = 0;
+  bool masked = false;  ///< all its rows invalid (held out): not a replicate
 };
 
 double lin(uint8_t c) { return std::pow(10.0, c / 10.0); }
@@ -169,9 +170,21 @@ AppearanceFigures measureAppearance(const std::vector<PolarScan>& scans) {
   int n_side = 0;
   std::vector<double> row_means;
   for (const PolarScan& full : scans) {
-    for (int v = 0; v < int(full.power.size()); ++v) hist_all[full.power[v]] += 1;
+    const bool has_valid = full.valid.size() == size_t(full.azimuths);
+    for (int a = 0; a < full.azimuths; ++a)
+      if (!has_valid || full.valid[a])
+        for (int b = 0; b < full.bins; ++b) hist_all[full.row(a)[b]] += 1;
     const int Q = 4, rows = full.azimuths / Q;
     for (int q = 0; q < Q; ++q) {
+      // A quarter whose rows are all masked out (held out for the check) is no replicate.
+      bool any = !has_valid;
+      for (int a = q * rows; a < (q + 1) * rows && !any; ++a) any = full.valid[a] != 0;
+      if (!any) {
+        Replicate r;
+        r.masked = true;
+        reps.push_back(r);
+        continue;
+      }
       PolarScan s;
       s.resize(rows, full.bins);
       s.range_resolution = full.range_resolution;
@@ -211,10 +224,16 @@ AppearanceFigures measureAppearance(const std::vector<PolarScan>& scans) {
           break;
         }
       std::array<double, kBands> fl{};
+      int used = 0;
       for (int q = 0; q < 4; ++q)
-        for (int k = 0; k < kBands; ++k) fl[k] += reps[ri + q].floor[k] / 4;
+        if (!reps[ri + q].masked) {
+          ++used;
+          for (int k = 0; k < kBands; ++k) fl[k] += reps[ri + q].floor[k];
+        }
+      for (int k = 0; k < kBands; ++k) fl[k] /= std::max(used, 1);
       const int rows = s.azimuths / 4;
       for (int q = 0; q < 4; ++q) {
+        if (reps[ri + q].masked) continue;
         PolarScan sub;
         const int a0 = std::max(0, q * rows - 6), a1 = std::min(s.azimuths, (q + 1) * rows + 6);
         sub.resize(a1 - a0, s.bins);
@@ -235,6 +254,8 @@ AppearanceFigures measureAppearance(const std::vector<PolarScan>& scans) {
       ri += 4;
     }
   }
+  reps.erase(std::remove_if(reps.begin(), reps.end(), [](const Replicate& r) { return r.masked; }),
+             reps.end());
   auto collect = [&](auto get, double& m, double& se) {
     std::vector<double> v;
     for (const auto& r : reps) v.push_back(get(r));

@@ -64,10 +64,11 @@ void locateAppearance(AppearanceReport& rep) {
       "codes", 3.0, "log quantisation");
 }
 
-void realismBeforeAfter(const std::vector<PolarScan>& real, const AppearanceOptions& opt,
-                        AppearanceReport& rep) {
+void realismBeforeAfter(const std::vector<PolarScan>& real, const std::vector<PolarScan>& holdout,
+                        const AppearanceOptions& opt, AppearanceReport& rep) {
   sim::RealismOptions ro;
-  rep.realism_real = sim::computeRealism(real, "recording", ro);
+  rep.realism_real = sim::computeRealism(real, "recording, fit part", ro);
+  if (!holdout.empty()) rep.realism_holdout = sim::computeRealism(holdout, "recording, held out", ro);
   rep.realism_before =
       sim::computeRealism(renderReference(rep.base, rep.base_physics, opt, opt.seed + 1), "sim, base model", ro);
   rep.realism_after = sim::computeRealism(
@@ -79,6 +80,10 @@ void realismBeforeAfter(const std::vector<PolarScan>& real, const AppearanceOpti
   };
   rep.worst_gap_before = worst(sim::bandGaps(rep.realism_before, rep.realism_real));
   rep.worst_gap_after = worst(sim::bandGaps(rep.realism_after, rep.realism_real));
+  if (!holdout.empty()) {
+    rep.worst_holdout_before = worst(sim::bandGaps(rep.realism_before, rep.realism_holdout));
+    rep.worst_holdout_after = worst(sim::bandGaps(rep.realism_after, rep.realism_holdout));
+  }
 }
 
 }  // namespace detail
@@ -106,6 +111,24 @@ nlohmann::json AppearanceReport::toJson() const {
   j["fitted_physics"] = fitted_physics.toJson();
   j["worst_band_gap_before"] = worst_gap_before;
   j["worst_band_gap_after"] = worst_gap_after;
+  j["worst_band_gap_holdout_before"] = worst_holdout_before;
+  j["worst_band_gap_holdout_after"] = worst_holdout_after;
+  j["fit_scans"] = fit_scans;
+  j["holdout_scans"] = holdout_scans;
+  auto bands = [](const sim::RealismStats& s) {
+    nlohmann::json b;
+    b["mean"] = std::vector<double>(s.band_mean, s.band_mean + 4);
+    b["q90"] = std::vector<double>(s.band_q90, s.band_q90 + 4);
+    b["cacfar"] = std::vector<double>(s.band_cacfar, s.band_cacfar + 4);
+    b["cen2018"] = std::vector<double>(s.band_cen, s.band_cen + 4);
+    return b;
+  };
+  if (!realism_real.name.empty()) {
+    j["realism_bands"] = {{"recording_fit", bands(realism_real)},
+                          {"sim_before", bands(realism_before)},
+                          {"sim_after", bands(realism_after)}};
+    if (!realism_holdout.name.empty()) j["realism_bands"]["recording_holdout"] = bands(realism_holdout);
+  }
   j["runtime_s"] = runtime_s;
   return j;
 }
@@ -137,9 +160,18 @@ std::string AppearanceReport::summaryMarkdown() const {
   for (const auto& n : notes) os << "\n- " << n;
   if (!realism_real.name.empty()) {
     os << "\n\n### Realism figures before and after\n\n";
-    os << sim::formatRealismTable({realism_real, realism_before, realism_after});
-    os << "\nWorst per-band gap (mean, q90, CA-CFAR, Cen2018 per band): " << 100 * worst_gap_before
-       << " % before, " << 100 * worst_gap_after << " % after.\n";
+    std::vector<sim::RealismStats> cols = {realism_real};
+    if (!realism_holdout.name.empty()) cols.push_back(realism_holdout);
+    cols.push_back(realism_before);
+    cols.push_back(realism_after);
+    os << sim::formatRealismTable(cols);
+    os << "\nWorst per-band gap (mean, q90, CA-CFAR, Cen2018 per band), fit part (" << fit_scans
+       << " scans): " << 100 * worst_gap_before << " % before, " << 100 * worst_gap_after
+       << " % after.";
+    if (!realism_holdout.name.empty())
+      os << " Held-out part (" << holdout_scans << " scans; one scan: quarters 1 and 3): "
+         << 100 * worst_holdout_before << " % before, " << 100 * worst_holdout_after << " % after.";
+    os << "\n";
   }
   return os.str();
 }

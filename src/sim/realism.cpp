@@ -31,6 +31,11 @@ struct Corr {
 void countPlainCaCfar(const PolarScan& s, double min_range, double max_range, double per_band[4]) {
   constexpr int kTrain = 16, kGuard = 4;
   const double alpha = std::pow(10.0, 1.2);
+  static const std::vector<double> lut = [] {
+    std::vector<double> t(256);
+    for (int c = 0; c < 256; ++c) t[c] = std::pow(10.0, c / 10.0);
+    return t;
+  }();
   std::vector<double> lin(size_t(s.bins)), cum(size_t(s.bins) + 1);
   const int b0 = std::max(kTrain + kGuard, int(std::ceil(s.binOfRange(min_range))));
   const int b1 = std::min(s.bins - 1 - kTrain - kGuard, int(std::floor(s.binOfRange(max_range))));
@@ -39,7 +44,7 @@ void countPlainCaCfar(const PolarScan& s, double min_range, double max_range, do
     const uint8_t* row = s.row(a);
     cum[0] = 0;
     for (int b = 0; b < s.bins; ++b) {
-      lin[b] = std::pow(10.0, row[b] / 10.0);
+      lin[b] = lut[row[b]];
       cum[b + 1] = cum[b] + lin[b];
     }
     for (int b = b0; b <= b1; ++b) {
@@ -81,6 +86,11 @@ RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::stri
   double det_cen = 0, det_cfar = 0;
   std::vector<Keypoint> kps;
   for (const PolarScan& s : scans) {
+    // Counts per scan are per full rotation: a scan with rows masked out (held-out halves of a
+    // single real scan) is scaled up by its share of valid rows.
+    int valid_rows = s.azimuths;
+    if (!s.valid.empty()) valid_rows = int(std::count_if(s.valid.begin(), s.valid.end(), [](uint8_t v) { return v != 0; }));
+    const double per_rotation = valid_rows > 0 ? double(s.azimuths) / valid_rows : 0.0;
     int b0 = std::max(0, int(std::ceil(s.binOfRange(o.min_range))));
     int b1 = std::min(s.bins - 1, int(std::floor(s.binOfRange(o.max_range))));
     int lag_s = std::max(1, int(std::lround(0.25 / s.range_resolution)));
@@ -112,16 +122,18 @@ RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::stri
       dc.detector = "cen2018";
       Detector d(dc);
       d.detect(s, kps);
-      det_cen += kps.size();
+      det_cen += kps.size() * per_rotation;
       for (const Keypoint& kp : kps)
         for (int k = 0; k < 4; ++k)
-          if (kp.range >= band_edge[k] && kp.range < band_edge[k + 1]) cen_band[k] += 1;
+          if (kp.range >= band_edge[k] && kp.range < band_edge[k + 1]) cen_band[k] += per_rotation;
       dc.detector = "cfar";
       d.setConfig(dc);
       d.detect(s, kps);
-      det_cfar += kps.size();
+      det_cfar += kps.size() * per_rotation;
     }
-    countPlainCaCfar(s, o.min_range, o.max_range, cacfar);
+    double cf[4] = {0, 0, 0, 0};
+    countPlainCaCfar(s, o.min_range, o.max_range, cf);
+    for (int k = 0; k < 4; ++k) cacfar[k] += cf[k] * per_rotation;
   }
   const double ns = std::max<size_t>(scans.size(), 1);
   for (int k = 0; k < 4; ++k) {

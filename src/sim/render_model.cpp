@@ -107,6 +107,8 @@ RenderModel::RenderModel(const SensorConfig& s) : s_(s) {
     if (s.leakage_db > 0)
       tot += std::pow(10.0, (s.noise_floor_db + s.leakage_db) / 10.0 -
                                 (b + 0.5) * s.range_resolution / s.leakage_range);
+    // Range gain curve (STC beyond the single slope): receiver gain, so noise and returns alike.
+    tot *= std::pow(10.0, s.stcCurveDb((b + 0.5) * s.range_resolution) / 10.0);
     noise_lin_[b] = float(tot);
     noise_q_[b] = int16_t(std::clamp(std::lround(80.0 * std::log10(tot)), -600l, 1600l));
     thr_lin_[b] = float(tot * std::pow(10.0, s.render_threshold_db / 10.0));
@@ -204,6 +206,7 @@ double RenderModel::beamHalfWidthFor(double ratio) const {
 double RenderModel::pointPower(double rcs_db, double r) const {
   double lr = std::log10(std::max(r, 0.1));
   double db = s_.radar_constant_db + rcs_db - 40.0 * lr + s_.range_gain_db_per_decade * lr;
+  db += s_.stcCurveDb(r) + s_.returnGainDb(r);
   return std::pow(10.0, db / 10.0) * nearStc(s_, r);
 }
 

@@ -196,6 +196,8 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
     double r2 = dx * dx + dy * dy;
     if (r2 > r_cull * r_cull || r2 < 0.0025) return;
     double r = std::sqrt(r2);
+    // Textured clutter thinned by its density curve over range (grazing-angle visibility).
+    if (sc.clutter_u >= 0 && sc.clutter_u >= sensor.clutterDensityX(r)) return;
     int b = std::clamp(int(r / res), 0, M - 1);
     double p = double(sc.rcs_lin) * model.rangeFactor(std::max(r - travel, 0.3));
     double thr = std::min<double>(model.thresholdLin(b), noise_mid);

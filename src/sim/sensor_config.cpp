@@ -1,6 +1,7 @@
 #include "spinradar/sim/sensor_config.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +21,53 @@ void SensorConfig::validate() const {
     throw std::invalid_argument("sensor parameter 'bins' is too large for the speckle table");
   if (encoder_size < azimuths)
     throw std::invalid_argument("sensor parameter 'encoder_size' must be at least 'azimuths'");
+}
+
+void SensorConfig::curveWeights(double r, double w[4]) {
+  for (int k = 0; k < 4; ++k) w[k] = 0;
+  if (r <= kCurveNodes[0]) {
+    w[0] = 1;
+    return;
+  }
+  for (int k = 0; k < 3; ++k)
+    if (r < kCurveNodes[k + 1]) {
+      const double t = std::log(r / kCurveNodes[k]) / std::log(kCurveNodes[k + 1] / kCurveNodes[k]);
+      w[k] = 1 - t, w[k + 1] = t;
+      return;
+    }
+  w[3] = 1;
+}
+
+namespace {
+double curveAt(double r, double a, double b, double c, double d) {
+  double w[4];
+  SensorConfig::curveWeights(r, w);
+  return w[0] * a + w[1] * b + w[2] * c + w[3] * d;
+}
+}  // namespace
+
+double SensorConfig::stcCurveDb(double r) const {
+  return curveAt(r, stc_curve_db_5m, stc_curve_db_16m, stc_curve_db_35m, stc_curve_db_71m);
+}
+double SensorConfig::returnGainDb(double r) const {
+  return curveAt(r, return_gain_db_5m, return_gain_db_16m, return_gain_db_35m, return_gain_db_71m);
+}
+double SensorConfig::clutterDensityX(double r) const {
+  return curveAt(r, clutter_density_x_5m, clutter_density_x_16m, clutter_density_x_35m,
+                 clutter_density_x_71m);
+}
+double SensorConfig::clutterDensityXMax() const {
+  return std::max({clutter_density_x_5m, clutter_density_x_16m, clutter_density_x_35m,
+                   clutter_density_x_71m});
+}
+bool SensorConfig::hasRangeCurves() const {
+  for (double v : {stc_curve_db_5m, stc_curve_db_16m, stc_curve_db_35m, stc_curve_db_71m,
+                   return_gain_db_5m, return_gain_db_16m, return_gain_db_35m, return_gain_db_71m})
+    if (v != 0) return true;
+  for (double v : {clutter_density_x_5m, clutter_density_x_16m, clutter_density_x_35m,
+                   clutter_density_x_71m})
+    if (v != 1) return true;
+  return false;
 }
 
 nlohmann::json SensorConfig::toJson() const {

@@ -170,7 +170,12 @@ void Simulator::Impl::addTexturedClutter() {
   }
   const double m = sensor.maxRange();
   x0 -= m, y0 -= m, x1 += m, y1 += m;
-  const double n_exp = (x1 - x0) * (y1 - y0) * sensor.clutter_density;
+  // A density curve over range (clutter_density_x_*) thins a field laid at its largest node.
+  const double x_max = sensor.clutterDensityXMax();
+  if (x_max <= 0) return;
+  const double n_exp = (x1 - x0) * (y1 - y0) * sensor.clutter_density * x_max;
+  const bool thinned = sensor.clutter_density_x_5m != 1 || sensor.clutter_density_x_16m != 1 ||
+                       sensor.clutter_density_x_35m != 1 || sensor.clutter_density_x_71m != 1;
   if (n_exp > 2e7)
     throw std::invalid_argument("sensor parameter 'clutter_density': " + std::to_string(n_exp) +
                                 " scatterers over this route, more than 2e7");
@@ -182,6 +187,10 @@ void Simulator::Impl::addTexturedClutter() {
     c.x = x0 + (x1 - x0) * rng.uniform();
     c.y = y0 + (y1 - y0) * rng.uniform();
     c.rcs_db = float(sensor.clutter_rcs_db + sensor.clutter_rcs_sd_db * rng.normal());
+    // Nested thinning: the first k scatterers are a uniform field of density k / area, so
+    // scatterer i shows where the density multiplier exceeds i / (area * clutter_density)
+    // (a larger multiplier only adds scatterers: the figures move smoothly with the curve).
+    if (thinned) c.clutter_u = float(double(i) / ((x1 - x0) * (y1 - y0) * sensor.clutter_density));
     statics.push_back(c);
   }
 }

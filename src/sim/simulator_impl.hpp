@@ -20,6 +20,7 @@ struct Scatterer {
   float vx = 0, vy = 0;   ///< m/s (movers only)
   int32_t wall = -1;      ///< wall it belongs to (occlusion exemption), -1 = none
   int32_t mirror = -1;    ///< multipath ghost: wall it is mirrored in, -1 = direct
+  float clutter_u = -1;   ///< textured clutter: shown where clutterDensityX(r) > this
 };
 
 /// Effects beyond the named ones, read from PhysicsConfig::extra.

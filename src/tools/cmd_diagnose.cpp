@@ -34,6 +34,8 @@ struct DiagnoseArgs {
   bool appearance = false;
   std::string sensor;  // base sensor model of the appearance stage (file or calibrated name)
   int appearance_scans = 4;
+  int curve_iterations = 16;
+  bool no_holdout = false;
 };
 
 /// The appearance stage (no world or trajectory needed): findings, fitted sensor file, plots
@@ -50,6 +52,8 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   s.validate();
   diagnose::AppearanceOptions opt;
   opt.scans = a.appearance_scans;
+  opt.curve_iterations = a.curve_iterations;
+  opt.holdout = !a.no_holdout;
   const auto rep = diagnose::diagnoseAppearance(scans, s, physics, opt);
   const std::string dir = (fs::path(a.out) / "appearance").string();
   diagnose::writeAppearanceReport(rep, scans, opt, dir);
@@ -63,7 +67,11 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
     }
   if (!named) std::cout << " nothing named";
   std::cout << "\nappearance: worst per-band realism gap " << 100 * rep.worst_gap_before << " % -> "
-            << 100 * rep.worst_gap_after << " %; report and sensor_fitted.json in " << dir << "\n";
+            << 100 * rep.worst_gap_after << " % (fit part, " << rep.fit_scans << " scans)";
+  if (rep.holdout_scans > 0)
+    std::cout << ", held out " << 100 * rep.worst_holdout_before << " % -> "
+              << 100 * rep.worst_holdout_after << " % (" << rep.holdout_scans << " scans)";
+  std::cout << "; report and sensor_fitted.json in " << dir << "\n";
 }
 
 /// The recording as a scan folder: a rosbag of RadarScan messages is first unpacked into
@@ -271,6 +279,11 @@ SPINRADAR_COMMAND(
       app.add_option("--sensor", a->sensor,
                      "Base sensor model of the appearance stage: JSON file or calibrated name "
                      "(oxford, mulran, boreas_rt, radiate); default: the CIR204-H defaults");
+      app.add_option("--appearance-curve-iterations", a->curve_iterations,
+                     "Steps of the per-band calibration (range curves; 0 = off)");
+      app.add_flag("--appearance-no-holdout", a->no_holdout,
+                   "Fit the appearance on the whole recording (default: fit on the first half of "
+                   "the scans, or quarters 0 and 2 of a single scan, check on the rest)");
       app.add_option("--appearance-scans", a->appearance_scans,
                      "Re-simulated scans per evaluation in the appearance fit")
           ->capture_default_str();

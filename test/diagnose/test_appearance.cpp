@@ -28,6 +28,8 @@ AppearanceOptions quickOptions() {
   o.fit_clutter = false;
   o.fit_near_stc = false;
   o.relinearise = false;
+  o.holdout = false;
+  o.curve_iterations = 0;
   return o;
 }
 

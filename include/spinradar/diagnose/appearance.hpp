@@ -83,6 +83,11 @@ struct AppearanceOptions {
   bool fit_near_stc = true;    ///< include the near-range STC ramp in the fit
   bool relinearise = true;     ///< recompute the figure Jacobian at every Newton step
   bool realism = true;         ///< realism tables before/after (with detectors)
+  /// Per-band calibration after the global fit: range curves fitted on the per-band realism
+  /// figures (fitRangeCurves); 0 iterations = off.
+  int curve_iterations = 16;
+  /// Fit on part of the recording and check on the rest (splitHoldout).
+  bool holdout = true;
 };
 
 struct AppearanceReport {
@@ -92,8 +97,12 @@ struct AppearanceReport {
   sim::SensorConfig base, fitted;
   sim::PhysicsConfig base_physics, fitted_physics;
   AppearanceFigures real, before, after;
-  sim::RealismStats realism_real, realism_before, realism_after;
-  double worst_gap_before = 0, worst_gap_after = 0;  ///< per-band realism gap (relative)
+  /// Realism figures of the recording's fit part (realism_real) and held-out part, and of the
+  /// reference scene re-simulated with the base and the fitted model (another noise seed).
+  sim::RealismStats realism_real, realism_holdout, realism_before, realism_after;
+  double worst_gap_before = 0, worst_gap_after = 0;  ///< per-band realism gap (relative), fit part
+  double worst_holdout_before = 0, worst_holdout_after = 0;  ///< the same on the held-out part
+  int fit_scans = 0, holdout_scans = 0;  ///< scans (or masked half scans) in each part
   double runtime_s = 0;
   nlohmann::json toJson() const;
   std::string summaryMarkdown() const;
@@ -110,6 +119,24 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real,
                                     const sim::SensorConfig& sensor,
                                     const sim::PhysicsConfig& physics,
                                     const AppearanceOptions& opt = {});
+
+/// Splits a recording for a held-out check: several scans: the first half (rounded up) to fit,
+/// the rest held out; one scan: its quarters 0 and 2 to fit, 1 and 3 held out (rows masked
+/// through PolarScan::valid; realism counts stay per full rotation).
+void splitHoldout(const std::vector<PolarScan>& scans, std::vector<PolarScan>& fit,
+                  std::vector<PolarScan>& holdout);
+
+/// Realism figures of the reference scene rendered with `sensor` / `physics`.
+sim::RealismStats realismOf(const sim::SensorConfig& sensor, const sim::PhysicsConfig& physics,
+                            const AppearanceOptions& opt, uint64_t seed, const std::string& name);
+
+/// Fits the range curves (stc_curve_db_*, return_gain_db_*, clutter_density_x_*) from `start`
+/// so that the per-band realism figures (mean, q90, plain CA-CFAR cells, Cen2018 keypoints) of
+/// the reference scene re-simulated match `real` (Levenberg-Marquardt on log figures). Steps
+/// taken go to `log`.
+sim::SensorConfig fitRangeCurves(const sim::RealismStats& real, const sim::SensorConfig& start,
+                                 const sim::PhysicsConfig& physics, const AppearanceOptions& opt,
+                                 std::vector<std::string>* log = nullptr);
 
 /// Writes appearance.json, appearance.md, sensor_fitted.json, physics_fitted.json and PNG
 /// plots (band profiles before/after, intensity histograms) into out_dir.

@@ -45,7 +45,19 @@
   X(double, wall_spacing, 0.25, 0.02, 5.0, "m", "Spacing of the scatterers a wall is rendered with") \
   X(double, wall_texture_db, 5.0, 0.0, 20.0, "dB", "Std of the per-scatterer facade texture") \
   X(double, occlusion_tolerance, 0.25, 0.0, 5.0, "m", "Scatterers this far behind the first wall still show") \
-  X(double, render_threshold_db, -6.0, -40.0, 20.0, "dB", "Contributions below noise floor + this are skipped")
+  X(double, render_threshold_db, -6.0, -40.0, 20.0, "dB", "Contributions below noise floor + this are skipped") \
+  X(double, stc_curve_db_5m, 0.0, -40.0, 40.0, "dB", "Range gain curve (STC) correction at 5 m, on noise and returns (curves: linear in log range between 5, 16, 35, 71 m, flat outside)") \
+  X(double, stc_curve_db_16m, 0.0, -40.0, 40.0, "dB", "Range gain curve (STC) correction at 16 m, on noise and returns") \
+  X(double, stc_curve_db_35m, 0.0, -40.0, 40.0, "dB", "Range gain curve (STC) correction at 35 m, on noise and returns") \
+  X(double, stc_curve_db_71m, 0.0, -40.0, 40.0, "dB", "Range gain curve (STC) correction at 71 m, on noise and returns") \
+  X(double, return_gain_db_5m, 0.0, -40.0, 40.0, "dB", "Gain of returns, not noise, at 5 m (elevation beam pattern on the ground and targets)") \
+  X(double, return_gain_db_16m, 0.0, -40.0, 40.0, "dB", "Gain of returns, not noise, at 16 m") \
+  X(double, return_gain_db_35m, 0.0, -40.0, 40.0, "dB", "Gain of returns, not noise, at 35 m") \
+  X(double, return_gain_db_71m, 0.0, -40.0, 40.0, "dB", "Gain of returns, not noise, at 71 m") \
+  X(double, clutter_density_x_5m, 1.0, 0.0, 20.0, "", "Textured clutter density at 5 m relative to clutter_density (grazing-angle visibility)") \
+  X(double, clutter_density_x_16m, 1.0, 0.0, 20.0, "", "Textured clutter density at 16 m relative to clutter_density") \
+  X(double, clutter_density_x_35m, 1.0, 0.0, 20.0, "", "Textured clutter density at 35 m relative to clutter_density") \
+  X(double, clutter_density_x_71m, 1.0, 0.0, 20.0, "", "Textured clutter density at 71 m relative to clutter_density")
 // clang-format on
 
 namespace spinradar::sim {
@@ -64,6 +76,15 @@ struct SensorConfig {
   /// Names of the calibrated sensor files found.
   static std::vector<std::string> namedSensors();
   void save(const std::string& path) const;
+  /// Range curves (stc_curve_db_*, return_gain_db_*, clutter_density_x_*): node ranges, and the
+  /// interpolation weights of the four nodes at range r (linear in log range, flat outside).
+  static constexpr double kCurveNodes[4] = {5.0, 16.0, 35.0, 71.0};
+  static void curveWeights(double r, double w[4]);
+  double stcCurveDb(double r) const;     ///< receiver gain correction (noise and returns), dB
+  double returnGainDb(double r) const;   ///< gain of returns only, dB
+  double clutterDensityX(double r) const;  ///< relative textured clutter density
+  double clutterDensityXMax() const;     ///< largest node of clutter_density_x_*
+  bool hasRangeCurves() const;           ///< any curve node away from its neutral value
   /// Maximum rendered range (m): bins * range_resolution.
   double maxRange() const { return bins * range_resolution; }
 };

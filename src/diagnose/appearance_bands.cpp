@@ -1,0 +1,197 @@
+// Appearance stage: per-band calibration (appearance.hpp, fitRangeCurves). One STC slope and one
+// clutter density cannot match every range band of a real sensor: its receiver gain curve, the
+// elevation pattern the ground is seen through and the clutter the ground shows vary with range.
+// Three curves over range (4 nodes each, sensor_config.hpp) are fitted so that the per-band
+// realism figures (mean, q90, plain CA-CFAR cells, Cen2018 keypoints) of the re-simulated
+// reference scene match the recording's: Levenberg-Marquardt on log figures, the Jacobian from
+// a re-simulation with each of the 12 nodes nudged.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+
+#include <Eigen/Dense>
+
+#include "appearance_detail.hpp"
+
+namespace spinradar::diagnose {
+
+using sim::SensorConfig;
+
+namespace {
+
+constexpr int kTypes = 3;  // receiver gain curve, return gain curve, clutter density curve
+constexpr int kPerBand = 4;  // mean, q90, CA-CFAR cells, Cen2018 keypoints
+constexpr int kGlobals = 2;  // noise texture (dB), median clutter RCS (dBsm)
+constexpr int kRows = kBands * kPerBand, kCols = kTypes * kBands + kGlobals;
+
+double* node(SensorConfig& s, int type, int j) {
+  static double SensorConfig::*const f[kTypes][kBands] = {
+      {&SensorConfig::stc_curve_db_5m, &SensorConfig::stc_curve_db_16m,
+       &SensorConfig::stc_curve_db_35m, &SensorConfig::stc_curve_db_71m},
+      {&SensorConfig::return_gain_db_5m, &SensorConfig::return_gain_db_16m,
+       &SensorConfig::return_gain_db_35m, &SensorConfig::return_gain_db_71m},
+      {&SensorConfig::clutter_density_x_5m, &SensorConfig::clutter_density_x_16m,
+       &SensorConfig::clutter_density_x_35m, &SensorConfig::clutter_density_x_71m}};
+  return &(s.*f[type][j]);
+}
+
+// Parameters of the fit, chosen to act on separate figures: type 0 = level of the noise (the
+// receiver gain curve), type 1 = level of the returns (receiver gain + return gain), both dB;
+// type 2 = log2 of the clutter density multiplier.
+double getParam(const SensorConfig& s, int type, int j) {
+  SensorConfig& m = const_cast<SensorConfig&>(s);
+  if (type == kTypes) return j == 0 ? s.noise_texture_db : s.clutter_rcs_db;
+  if (type == 0) return *node(m, 0, j);
+  if (type == 1) return *node(m, 0, j) + *node(m, 1, j);
+  return std::log2(std::max(*node(m, 2, j), 1.0 / 64));
+}
+void setParam(SensorConfig& s, int type, int j, double p) {
+  if (type == kTypes) {
+    if (j == 0)
+      s.noise_texture_db = std::clamp(p, 0.0, 15.0);
+    else
+      s.clutter_rcs_db = std::clamp(p, -80.0, 20.0);
+  } else if (type == 2) {
+    *node(s, 2, j) = std::clamp(std::exp2(p), 1.0 / 64, 20.0);
+  } else if (type == 1) {
+    *node(s, 1, j) = std::clamp(p - *node(s, 0, j), -40.0, 40.0);
+  } else {
+    const double returns = *node(s, 0, j) + *node(s, 1, j);  // kept
+    *node(s, 0, j) = std::clamp(p, -40.0, 40.0);
+    *node(s, 1, j) = std::clamp(returns - *node(s, 0, j), -40.0, 40.0);
+  }
+}
+
+Eigen::VectorXd logFigures(const sim::RealismStats& st) {
+  Eigen::VectorXd v(kRows);
+  for (int k = 0; k < kBands; ++k) {
+    v[kPerBand * k + 0] = std::log(1 + st.band_mean[k]);
+    v[kPerBand * k + 1] = std::log(1 + st.band_q90[k]);
+    v[kPerBand * k + 2] = std::log(1 + st.band_cacfar[k]);
+    v[kPerBand * k + 3] = std::log(1 + std::max(st.band_cen[k], 0.0));
+  }
+  return v;
+}
+
+}  // namespace
+
+sim::RealismStats realismOf(const SensorConfig& s, const sim::PhysicsConfig& physics,
+                            const AppearanceOptions& opt, uint64_t seed, const std::string& name) {
+  return sim::computeRealism(renderReference(s, physics, opt, seed), name, sim::RealismOptions{});
+}
+
+void splitHoldout(const std::vector<PolarScan>& scans, std::vector<PolarScan>& fit,
+                  std::vector<PolarScan>& holdout) {
+  fit.clear();
+  holdout.clear();
+  if (scans.size() >= 2) {
+    const size_t n_fit = (scans.size() + 1) / 2;
+    fit.assign(scans.begin(), scans.begin() + n_fit);
+    holdout.assign(scans.begin() + n_fit, scans.end());
+    return;
+  }
+  for (const PolarScan& s : scans) {
+    // One scan: quarters 0 and 2 to fit, 1 and 3 held out (different parts of the scene).
+    PolarScan a = s, b = s;
+    a.valid.assign(s.azimuths, 0);
+    b.valid.assign(s.azimuths, 0);
+    const int rows = s.azimuths / 4;
+    for (int r = 0; r < s.azimuths; ++r) {
+      const bool orig = s.valid.empty() || s.valid[r];
+      const bool first = (std::min(r / std::max(rows, 1), 3) % 2) == 0;
+      (first ? a : b).valid[r] = orig ? 1 : 0;
+    }
+    fit.push_back(std::move(a));
+    holdout.push_back(std::move(b));
+  }
+}
+
+SensorConfig fitRangeCurves(const sim::RealismStats& real, const SensorConfig& start,
+                            const sim::PhysicsConfig& physics, const AppearanceOptions& opt,
+                            std::vector<std::string>* log) {
+  SensorConfig cur = start;
+  if (cur.clutter_density <= 0) cur.clutter_density = 0.05;
+  const Eigen::VectorXd target = logFigures(real);
+  auto eval = [&](const SensorConfig& s, Eigen::VectorXd& f) {
+    try {
+      f = logFigures(realismOf(s, physics, opt, opt.seed, ""));
+      return true;
+    } catch (const std::invalid_argument&) {  // e.g. too many clutter scatterers
+      return false;
+    }
+  };
+  Eigen::VectorXd f_cur;
+  if (!eval(cur, f_cur)) return start;
+  // Per type (noise level, return level, log2 clutter density, globals): finite-difference
+  // step, damping scale and largest move per iteration.
+  const double step[kTypes + 1] = {3.0, 3.0, 0.7, 1.5}, scale[kTypes + 1] = {3.0, 3.0, 1.0, 2.0},
+               limit[kTypes + 1] = {6.0, 6.0, 1.5, 3.0};
+  auto cost = [&](const Eigen::VectorXd& f) { return (f - target).squaredNorm(); };
+  double lambda = 0.1;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(kRows, kCols);
+  bool refresh = true;
+  const bool verbose = std::getenv("SPINRADAR_APPEARANCE_VERBOSE") != nullptr;
+  for (int it = 0; it < opt.curve_iterations; ++it) {
+    // Jacobian column by column: every node nudged on its own (the Cen2018 threshold is a
+    // statistic of the whole row, so a node moves the keypoints of every band).
+    // Between full ones (every 4th iteration), Broyden's rank-one updates from the steps taken.
+    const bool full = refresh || it % 4 == 0;
+    refresh = false;
+    if (full) for (int c = 0; c < kCols; ++c) {
+      const int t = std::min(c / kBands, kTypes), j = c - t * kBands;
+      SensorConfig s = cur;
+      setParam(s, t, j, getParam(cur, t, j) + step[t]);
+      Eigen::VectorXd f;
+      if (eval(s, f)) J.col(c) = (f - f_cur) / step[t];
+    }
+    const Eigen::VectorXd r = target - f_cur;
+    bool accepted = false;
+    for (int tries = 0; tries < 4 && !accepted; ++tries) {
+      Eigen::MatrixXd N = J.transpose() * J;
+      for (int c = 0; c < kCols; ++c) {
+        const int t = std::min(c / kBands, kTypes);
+        N(c, c) += lambda / (scale[t] * scale[t]);
+      }
+      const Eigen::VectorXd d = N.ldlt().solve(J.transpose() * r);
+      SensorConfig trial = cur;
+      // Type 0 before type 1: setting the noise level keeps the returns' level.
+      for (int c = 0; c < kCols; ++c) {
+        const int t = std::min(c / kBands, kTypes), j = c - t * kBands;
+        setParam(trial, t, j, getParam(cur, t, j) + std::clamp(d[c], -limit[t], limit[t]));
+      }
+      Eigen::VectorXd f_trial;
+      const bool ok = eval(trial, f_trial);
+      if (verbose) {
+        std::cerr << "curves it " << it << " try " << tries << " lambda " << lambda << " cost "
+                  << cost(f_cur) << " -> " << (ok ? cost(f_trial) : -1) << "\n  target "
+                  << target.array().exp().transpose() - 1 << "\n  cur    "
+                  << f_cur.array().exp().transpose() - 1 << "\n  trial  "
+                  << (ok ? Eigen::VectorXd(f_trial.array().exp() - 1) : f_cur).transpose()
+                  << "\n  step   " << d.transpose() << "\n";
+      }
+      if (ok && cost(f_trial) < cost(f_cur)) {
+        if (log)
+          log->push_back("range curves, step " + std::to_string(it + 1) + ": log-figure misfit " +
+                         std::to_string(cost(f_cur)) + " -> " + std::to_string(cost(f_trial)));
+        Eigen::VectorXd dx(kCols);
+        for (int c = 0; c < kCols; ++c) {
+          const int t = std::min(c / kBands, kTypes), j = c - t * kBands;
+          dx[c] = getParam(trial, t, j) - getParam(cur, t, j);
+        }
+        if (dx.squaredNorm() > 0) J += (f_trial - f_cur - J * dx) * dx.transpose() / dx.squaredNorm();
+        cur = trial;
+        f_cur = f_trial;
+        lambda = std::max(lambda / 3, 1e-3);
+        accepted = true;
+      } else {
+        lambda *= 4;
+      }
+    }
+    if (!accepted && full) break;
+    if (!accepted) refresh = true;  // the updated Jacobian failed: recompute it
+  }
+  return cur;
+}
+
+}  // namespace spinradar::diagnose
