@@ -169,8 +169,8 @@ TEST(Cartesian, PixelGeometryEqualsHypotAndAtan2PerPixel) {
                                    {0.0438 * 6, 1000}, {0.1, 64}}) {
     CartesianProjector proj(res, width);
     const double centre = 0.5 * (width - 1);
-    const std::vector<float>& range = proj.pixelRanges();
-    const std::vector<uint16_t>& angle = proj.pixelAngles();
+    const auto& range = proj.pixelRanges();
+    const auto& angle = proj.pixelAngles();
     ASSERT_EQ(range.size(), size_t(width) * width);
     ASSERT_EQ(angle.size(), size_t(width) * width);
     int wrong = 0;

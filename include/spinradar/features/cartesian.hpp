@@ -6,6 +6,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "spinradar/core/polar_scan.hpp"
+#include "spinradar/features/huge_page_allocator.hpp"
 
 namespace spinradar {
 
@@ -52,8 +53,10 @@ class CartesianProjector {
   int tableBuilds() const { return builds_; }  ///< how many times the remap tables were built
   /// Per pixel (row-major): range (m) of its centre and clockwise angle from forward in
   /// 1/65536 turns, from which the tables are built.
-  const std::vector<float>& pixelRanges() const { return pixel_range_; }
-  const std::vector<uint16_t>& pixelAngles() const { return pixel_angle_; }
+  template <class T>
+  using Table = std::vector<T, HugePageAllocator<T>>;
+  const Table<float>& pixelRanges() const { return pixel_range_; }
+  const Table<uint16_t>& pixelAngles() const { return pixel_angle_; }
 
  private:
   bool geometryChanged(const PolarScan& scan, double offset) const;
@@ -72,13 +75,13 @@ class CartesianProjector {
   std::vector<double> angles_;
   int box_ = 1;  ///< range bins averaged per pixel
   // per image geometry: range (m) and angle (clockwise, 1/65536 turns) of every pixel
-  std::vector<float> pixel_range_;
-  std::vector<uint16_t> pixel_angle_;
+  Table<float> pixel_range_;
+  Table<uint16_t> pixel_angle_;
   std::vector<uint32_t> angle_row_;  ///< 65536 entries: (row << 8) | weight of the next row
   // tables and scratch
-  std::vector<uint32_t> offset_table_;  ///< per pixel: index of its (row, bin) in polar_
+  Table<uint32_t> offset_table_;  ///< per pixel: index of its (row, bin) in polar_
   std::vector<uint8_t> weight_table_;   ///< per pixel: weight of the next row, /256
-  std::vector<uint8_t> polar_;  ///< (azimuths + 3) x bins: smoothed rows, row 0 again (wrap), 2 zero rows
+  Table<uint8_t> polar_;  ///< (azimuths + 3) x bins: smoothed rows, row 0 again (wrap), 2 zero rows
 };
 
 }  // namespace spinradar
