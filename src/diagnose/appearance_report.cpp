@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "appearance_detail.hpp"
+#include "markdown_table.hpp"
 #include "spinradar/evaluation/plot.hpp"
 
 namespace spinradar::diagnose {
@@ -145,16 +146,17 @@ std::string AppearanceReport::summaryMarkdown() const {
   os << "\n\n### Where (real vs re-simulated with the base model)\n\n";
   for (const auto& l : locate)
     if (!l.note.empty()) os << "- " << l.by << ", " << l.note << "\n";
-  os << "\n| by | where | real | sim | unit |\n|---|---|---|---|---|\n";
-  for (const auto& l : locate)
-    os << "| " << l.by << " | " << l.where << " | " << l.real << " | " << l.sim << " | " << l.unit << " |\n";
-  os << "\n### Named and fitted (catalogue of sensor physics)\n\n";
-  os << "| effect | parameter | base | fitted | +- | z | size | verdict | figure gap before -> after |\n";
-  os << "|---|---|---|---|---|---|---|---|---|\n";
+  MarkdownTable where({"by", "where", "real", "sim", "unit"}, 3);
+  for (const auto& l : locate) where.row(l.by, l.where, l.real, l.sim, l.unit);
+  MarkdownTable fitted({"effect", "parameter", "base", "fitted", "+-", "z", "size", "verdict",
+                        "figure gap before -> after"},
+                       3);
   for (const auto& f : findings)
-    os << "| " << f.effect << " | " << f.parameter << " (" << f.unit << ") | " << f.base << " | "
-       << f.value << " | " << f.stddev << " | " << f.z << " | " << f.size << " " << f.size_unit
-       << " | " << f.verdict << " | " << f.gap_before << " -> " << f.gap_after << " |\n";
+    fitted.row(f.effect, f.parameter + " (" + f.unit + ")", f.base, f.value, f.stddev, f.z,
+               fmt(f.size, 3) + " " + f.size_unit, f.verdict,
+               fmt(f.gap_before, 3) + " -> " + fmt(f.gap_after, 3));
+  os << "\n" << where.str();
+  os << "\n### Named and fitted (catalogue of sensor physics)\n\n" << fitted.str();
   os << "\nPractical thresholds: levels 1 dB, widths 10 %, slopes 2 dB/decade; smaller "
         "significant changes are reported as negligible, not as mismatches.\n";
   for (const auto& n : notes) os << "\n- " << n;

@@ -8,6 +8,7 @@
 #include "spinradar/evaluation/plot.hpp"
 #include "spinradar/diagnose/advice.hpp"
 #include "spinradar/diagnose/diagnose.hpp"
+#include "markdown_table.hpp"
 
 namespace spinradar::diagnose {
 namespace {
@@ -32,12 +33,6 @@ nlohmann::json locateJson(const std::vector<LocateRow>& rows) {
                  {"rms_tangential_m", r.rms_t},
                  {"z", r.z}});
   return a;
-}
-
-std::string fmt(double v, int prec = 4) {
-  std::ostringstream s;
-  s << std::setprecision(prec) << v;
-  return s.str();
 }
 
 }  // namespace
@@ -128,36 +123,32 @@ std::string DiagnoseReport::summaryMarkdown() const {
     << fmt(after.range_rms) << " m, azimuth " << fmt(before.azimuth_rms * 180 / M_PI) << " -> "
     << fmt(after.azimuth_rms * 180 / M_PI) << " deg.\n\n";
   if (!effects.empty()) {
-    s << "## Effects found (most significant first)\n\n"
-      << "| effect | parameter | value | stddev | z | LR | dBIC | absorbed | rms before (m) | "
-         "rms after (m) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    MarkdownTable t({"effect", "parameter", "value", "stddev", "z", "LR", "dBIC", "absorbed",
+                     "rms before (m)", "rms after (m)"});
     for (const auto& e : effects)
-      s << "| " << e.name << " | " << e.parameter << (e.unit.empty() ? "" : " (" + e.unit + ")")
-        << " | " << fmt(e.value, 5) << " | " << fmt(e.stddev, 3) << " | "
-        << fmt(e.significance, 3) << " | " << fmt(e.lr, 4) << " | " << fmt(e.delta_bic, 4)
-        << " | " << fmt(e.absorbed, 2) << " | " << fmt(e.residual_rms_before) << " | "
-        << fmt(e.residual_rms_after) << " |\n";
-    s << "\n";
+      t.row(e.name, e.parameter + (e.unit.empty() ? "" : " (" + e.unit + ")"), fmt(e.value, 5),
+            fmt(e.stddev, 3), fmt(e.significance, 3), fmt(e.lr, 4), fmt(e.delta_bic, 4),
+            fmt(e.absorbed, 2), fmt(e.residual_rms_before), fmt(e.residual_rms_after));
+    s << "## Effects found (most significant first)\n\n" << t.str() << "\n";
   }
-  s << "## Every candidate against the base model\n\n"
-    << "| effect | estimate | stddev | z | LM | LR | p | dBIC | VIF | absorbed by scan "
-       "alignment |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  MarkdownTable cand({"effect", "estimate", "stddev", "z", "LM", "LR", "p", "dBIC", "VIF",
+                      "absorbed by scan alignment"});
   for (const auto& c : candidates)
-    s << "| " << effectName(c.effect) << " | " << fmt(c.estimate, 4) << " | " << fmt(c.stddev, 3)
-      << " | " << fmt(c.z, 3) << " | " << fmt(c.lm, 4) << " | " << fmt(c.lr, 4) << " | "
-      << fmt(c.p, 3) << " | " << fmt(c.delta_bic, 4) << " | " << fmt(c.vif, 3) << " | "
-      << fmt(c.absorbed_by_alignment, 2) << " |\n";
+    cand.row(effectName(c.effect), fmt(c.estimate, 4), fmt(c.stddev, 3), fmt(c.z, 3),
+             fmt(c.lm, 4), fmt(c.lr, 4), fmt(c.p, 3), fmt(c.delta_bic, 4), fmt(c.vif, 3),
+             fmt(c.absorbed_by_alignment, 2));
+  s << "## Every candidate against the base model\n\n" << cand.str();
   if (!notes.empty()) {
     s << "\n## Notes\n\n";
     for (const auto& n : notes) s << "- " << n << "\n";
   }
-  s << "\n## Where the residuals are (before fitting; |z| > 3 marked)\n\n"
-    << "| by | group | n | mean range (cm) | rms range (cm) | mean tangential (cm) | rms "
-       "tangential (cm) | z |\n|---|---|---|---|---|---|---|---|\n";
+  MarkdownTable where({"by", "group", "n", "mean range (cm)", "rms range (cm)",
+                       "mean tangential (cm)", "rms tangential (cm)", "z"});
   for (const auto& r : locate)
-    s << "| " << r.by << " | " << r.label << " | " << r.n << " | " << fmt(100 * r.mean_r, 3)
-      << " | " << fmt(100 * r.rms_r, 3) << " | " << fmt(100 * r.mean_t, 3) << " | "
-      << fmt(100 * r.rms_t, 3) << " | " << fmt(r.z, 3) << (r.z > 3 ? " **" : "") << " |\n";
+    where.row(r.by, r.label, r.n, fmt(100 * r.mean_r, 3), fmt(100 * r.rms_r, 3),
+              fmt(100 * r.mean_t, 3), fmt(100 * r.rms_t, 3),
+              fmt(r.z, 3) + (r.z > 3 ? " **" : ""));
+  s << "\n## Where the residuals are (before fitting; |z| > 3 marked)\n\n" << where.str();
   s << "\nFitted physics: `" << fitted.toJson().dump() << "`\n";
   s << "\nRuntime " << fmt(runtime_s, 3) << " s.\n";
   return s.str();

@@ -11,16 +11,11 @@
 #include "spinradar/diagnose/stats.hpp"
 #include "spinradar/diagnose/timing.hpp"
 #include "diagnose_steps.hpp"
+#include "markdown_table.hpp"
 #include "timing_detail.hpp"
 
 namespace spinradar::diagnose {
 namespace {
-
-std::string fmt(double v, int prec = 4) {
-  std::ostringstream s;
-  s << std::setprecision(prec) << v;
-  return s.str();
-}
 
 // Sub-nanosecond RMS is rounding of a perfect fit: print it as 0.
 double usRms(double s) { return s < 1e-9 ? 0.0 : s * 1e6; }
@@ -400,13 +395,11 @@ std::string TimingReport::summaryMarkdown() const {
       << fmt(100 * jitter_std_sd, 2) << " % (chi2 " << fmt(jitter_chi2, 4) << ", " << jitter_dof
       << " dof, p " << fmt(jitter_p, 3) << ").\n\n";
   if (!findings.empty()) {
-    s << "| timing effect | parameter | value | stddev | z | scans | evidence |\n"
-         "|---|---|---|---|---|---|---|\n";
+    MarkdownTable t({"timing effect", "parameter", "value", "stddev", "z", "scans", "evidence"});
     for (const auto& f : findings)
-      s << "| " << f.name << " | " << f.parameter << (f.unit.empty() ? "" : " (" + f.unit + ")")
-        << " | " << fmt(f.value, 5) << " | " << fmt(f.stddev, 3) << " | "
-        << fmt(f.significance, 3) << " | " << f.scans << " | " << f.evidence << " |\n";
-    s << "\n";
+      t.row(f.name, f.parameter + (f.unit.empty() ? "" : " (" + f.unit + ")"), fmt(f.value, 5),
+            fmt(f.stddev, 3), fmt(f.significance, 3), f.scans, f.evidence);
+    s << t.str() << "\n";
   }
   s << "**Timing model to use:**\n\n";
   for (const auto& a : advice) s << "- " << a << "\n";

@@ -7,22 +7,18 @@
 #include <filesystem>
 #include <iostream>
 
+#include "diagnose/appearance_fixtures.hpp"
 #include "spinradar/diagnose/appearance.hpp"
 #include "spinradar/sim/realism.hpp"
 
 namespace spinradar::diagnose {
 namespace {
 
-// 2300 bins x 0.0438 m = 100 m: all four bands, quick renders.
-sim::SensorConfig baseSensor() {
-  sim::SensorConfig s;
-  s.bins = 2300;
-  return s;
-}
+sim::SensorConfig baseSensor() { return testing::hundredMetreSensor(); }
 
+// The catalogue stage alone: the realism, curve and hold-out steps are tested elsewhere.
 AppearanceOptions quickOptions() {
-  AppearanceOptions o;
-  o.scans = 3;
+  AppearanceOptions o = testing::quickAppearanceOptions();
   o.iterations = 2;
   o.realism = false;
   o.fit_clutter = false;

@@ -8,24 +8,23 @@
 #include <cstdlib>
 #include <iostream>
 
+#include "diagnose/appearance_fixtures.hpp"
 #include "spinradar/diagnose/appearance.hpp"
 #include "spinradar/sim/realism.hpp"
 
 namespace spinradar::diagnose {
 namespace {
 
-// 2300 bins x 0.0438 m = 100 m: all four bands, quick renders.
+// All four bands with some clutter and noise texture for the curves to act on.
 sim::SensorConfig baseSensor() {
-  sim::SensorConfig s;
-  s.bins = 2300;
+  sim::SensorConfig s = testing::hundredMetreSensor();
   s.clutter_density = 0.1;
   s.noise_texture_db = 2.0;
   return s;
 }
 
 AppearanceOptions quick() {
-  AppearanceOptions o;
-  o.scans = 3;
+  AppearanceOptions o = testing::quickAppearanceOptions();
   o.curve_iterations = 8;
   return o;
 }
