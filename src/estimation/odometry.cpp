@@ -343,15 +343,20 @@ OdometryResult Odometry::process(const PolarScan& scan) {
   if (!d.extractor)
     d.extractor = std::make_unique<FeatureExtractor>(d.config.detector, d.config.features);
   StageTimes times;
-  d.extractor->extract(scan, d.cur.frame, &times);
-  if (d.config.estimator.azimuth_times == "uniform") uniformKeypointTimes(scan, d.cur.frame.keypoints);
+  extractFeatures(d.config, *d.extractor, scan, d.cur.frame, &times);
   return d.step(times);
 }
 
-OdometryResult Odometry::process(const FeatureFrame& frame) {
+void Odometry::extractFeatures(const PipelineConfig& config, FeatureExtractor& extractor,
+                               const PolarScan& scan, FeatureFrame& out, StageTimes* times) {
+  extractor.extract(scan, out, times);
+  if (config.estimator.azimuth_times == "uniform") uniformKeypointTimes(scan, out.keypoints);
+}
+
+OdometryResult Odometry::process(const FeatureFrame& frame, const StageTimes& times) {
   Impl& d = *impl_;
   d.cur.copyFrom(frame);
-  return d.step(StageTimes{});
+  return d.step(times);
 }
 
 const std::vector<Eigen::Vector2d>& Odometry::correctedPoints() const { return impl_->corrected; }

@@ -20,6 +20,7 @@
 #include "pipeline_options.hpp"
 #include "progress.hpp"
 #include "spinradar/estimation/odometry.hpp"
+#include "spinradar/features/feature_extractor.hpp"
 #include "spinradar/io/poses_io.hpp"
 #include "spinradar/io/scan_folder.hpp"
 
@@ -36,16 +37,21 @@ struct OdometryArgs {
 };
 
 /// Loads a folder's scans in order on one background thread, up to `depth` scans ahead of the
-/// consumer, so that decoding the next scans overlaps processing the current one. take() hands
-/// them out in order; a scan that failed to load rethrows its error there, at its own index,
-/// as the single-thread loop would. The scans live in a fixed ring of depth + 1 slots, each
-/// loaded into again once the consumer release()s it: no allocation per scan after warm-up.
+/// consumer, and extracts their features there too (Odometry::extractFeatures, which depends on
+/// the scan and the config only), so that decoding and features of the next scans overlap
+/// matching and estimation of the current one. take() hands them out in order; a scan that
+/// failed to load rethrows its error there, at its own index, as the single-thread loop would.
+/// The scans and their features live in a fixed ring of depth + 1 slots, each filled again once
+/// the consumer release()s it: no allocation per scan after warm-up.
 class ScanPrefetcher {
  public:
   struct Loaded {
     PolarScan scan;
     double load_ms = 0;
     std::string error;  ///< why the scan could not be read ("" when it was)
+    FeatureFrame frame;          ///< the scan's features (prefetcher only)
+    StageTimes times;            ///< their detect / Cartesian / describe times
+    std::string extract_error;   ///< extraction threw: the run stops there, as with one thread
   };
   /// Loads scan i of `folder` into `l`, reusing its buffers, and times it.
   static void loadInto(const ScanFolder& folder, size_t i, Loaded& l) {
@@ -58,8 +64,9 @@ class ScanPrefetcher {
     }
     l.load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
-  ScanPrefetcher(const ScanFolder& folder, size_t depth)
-      : folder_(folder), slots_(std::max<size_t>(1, depth) + 1), thread_([this] { loop(); }) {}
+  ScanPrefetcher(const ScanFolder& folder, size_t depth, const PipelineConfig& config)
+      : folder_(folder), config_(config), extractor_(config.detector, config.features),
+        slots_(std::max<size_t>(1, depth) + 1), thread_([this] { loop(); }) {}
   ~ScanPrefetcher() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -97,7 +104,16 @@ class ScanPrefetcher {
         cv_.wait(lock, [this, i] { return stop_ || i < released_ + slots_.size(); });  // slot i is free
         if (stop_) return;
       }
-      loadInto(folder_, i, slots_[i % slots_.size()]);  // outside the lock: the consumer may work meanwhile
+      Loaded& l = slots_[i % slots_.size()];  // outside the lock: the consumer may work meanwhile
+      loadInto(folder_, i, l);
+      l.extract_error.clear();
+      if (l.error.empty()) {
+        try {
+          Odometry::extractFeatures(config_, extractor_, l.scan, l.frame, &l.times);
+        } catch (const std::exception& e) {
+          l.extract_error = e.what();
+        }
+      }
       {
         std::lock_guard<std::mutex> lock(mutex_);
         loaded_ = i + 1;
@@ -107,6 +123,8 @@ class ScanPrefetcher {
   }
 
   const ScanFolder& folder_;
+  const PipelineConfig config_;
+  FeatureExtractor extractor_;  ///< used by the loader thread only
   std::vector<Loaded> slots_;
   std::mutex mutex_;
   std::condition_variable cv_;
@@ -126,9 +144,9 @@ void printStageTotals(const StageTimes& t, double load_ms, double wait_ms, bool 
   };
   row(prefetch ? "load (background)" : "load", load_ms);
   if (prefetch) row("waiting for loads", wait_ms);
-  row("detect", t.detect_ms);
-  row("cartesian", t.cartesian_ms);
-  row("describe", t.describe_ms);
+  row(prefetch ? "detect (bg)" : "detect", t.detect_ms);
+  row(prefetch ? "cartesian (bg)" : "cartesian", t.cartesian_ms);
+  row(prefetch ? "describe (bg)" : "describe", t.describe_ms);
   row("match", t.match_ms);
   row("estimate", t.estimate_ms);
   row("pipeline total", t.total());
@@ -189,11 +207,12 @@ void run(OdometryArgs& a) {
   // worth its other scans); the run stops when the first three all fail or none can be read.
   size_t skipped = 0, processed = 0;
   std::string first_error;
-  // With more than one thread the next scans are read while this one is processed.
+  // With more than one thread the next scans are read and their features extracted while this
+  // one is matched and estimated.
   const bool prefetch = a.threads != 1;
   double wait_ms = 0;
   std::optional<ScanPrefetcher> prefetcher;
-  if (prefetch) prefetcher.emplace(folder, 3);
+  if (prefetch) prefetcher.emplace(folder, 3, cfg);
   ScanPrefetcher::Loaded single;  // one thread: every scan is loaded into this one, reused
   struct ReleaseSlot {  // hands the prefetcher's slot back at the end of each iteration
     ScanPrefetcher* p;
@@ -217,8 +236,8 @@ void run(OdometryArgs& a) {
       continue;
     }
     ++processed;
-    PolarScan& scan = l.scan;
-    const OdometryResult r = odometry.process(scan);
+    if (!l.extract_error.empty()) throw std::runtime_error(l.extract_error);
+    const OdometryResult r = prefetch ? odometry.process(l.frame, l.times) : odometry.process(l.scan);
     totals += r.times;
     if (i > 0 && !r.ok) ++failures;
     PoseRecord p;
@@ -288,7 +307,8 @@ SPINRADAR_COMMAND(
                      "Oxford SDK uses 0.0432)")
           ->check(cli::positive());
       app.add_option("--threads", a->threads,
-                     "Worker threads (TBB limit; >1 also reads the next scan in the background); "
+                     "Worker threads (TBB limit; >1 also reads the next scans and extracts their "
+                     "features in the background); "
                      "0 = all cores")
           ->check(cli::atLeast(0));
       app.add_flag("--quiet,-q", a->quiet, "No progress line");

@@ -14,9 +14,12 @@
 #include "spinradar/core/feature_frame.hpp"
 #include "spinradar/core/params.hpp"
 #include "spinradar/core/polar_scan.hpp"
+#include "spinradar/core/stage_times.hpp"
 #include "spinradar/estimation/motion_estimate.hpp"
 
 namespace spinradar {
+
+class FeatureExtractor;
 
 class Odometry {
  public:
@@ -31,8 +34,15 @@ class Odometry {
 
   /// Full chain on a polar scan.
   OdometryResult process(const PolarScan& scan);
-  /// Estimation only, for features computed elsewhere (the feature nodelet).
-  OdometryResult process(const FeatureFrame& frame);
+  /// Estimation only, for features computed elsewhere (the feature nodelet, or extractFeatures()
+  /// on a loader thread); `times` (detect, Cartesian, describe) is passed through to the result.
+  OdometryResult process(const FeatureFrame& frame, const StageTimes& times = {});
+  /// The per-scan part of process(scan): features and keypoint times from the scan and
+  /// `config` alone (no estimator state), so another thread may run it ahead with its own
+  /// extractor (made from config.detector, config.features); process(frame) on the result
+  /// then gives what process(scan) gives.
+  static void extractFeatures(const PipelineConfig& config, FeatureExtractor& extractor,
+                              const PolarScan& scan, FeatureFrame& out, StageTimes* times);
 
   /// The last frame's keypoints moved to its reference time with the estimated velocity and,
   /// for mc_doppler/refined, Doppler-corrected: (x, y) in the sensor frame at stamp_ns.
