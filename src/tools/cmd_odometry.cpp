@@ -12,6 +12,8 @@
 #include <optional>
 #include <thread>
 
+#include <time.h>
+
 #include <tbb/global_control.h>
 
 #include "cli_checks.hpp"
@@ -28,6 +30,14 @@ namespace {
 
 using namespace spinradar;
 
+/// CPU time of the calling thread (ms): with the wall clock of a loaded machine, what each
+/// thread of the pipeline costs.
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
+}
+
 struct OdometryArgs {
   std::string input, out, format = "auto", cov_out, tum_out;
   double range_resolution = 0.0;
@@ -36,12 +46,15 @@ struct OdometryArgs {
   cli::PipelineOptions pipeline;
 };
 
-/// Loads a folder's scans in order on one background thread, up to `depth` scans ahead of the
+/// Loads a folder's scans on `workers` background threads, up to `depth` scans ahead of the
 /// consumer, and extracts their features there too (Odometry::extractFeatures, which depends on
-/// the scan and the config only), so that decoding and features of the next scans overlap
-/// matching and estimation of the current one. take() hands them out in order; a scan that
-/// failed to load rethrows its error there, at its own index, as the single-thread loop would.
-/// The scans and their features live in a fixed ring of depth + 1 slots, each filled again once
+/// the scan and the config only), so that decoding and features of the next scans (about 80 %
+/// of the CPU per scan) overlap matching and estimation of the current one. Scans are claimed
+/// in order by whichever thread is free, the consumer included: while take() waits it loads and
+/// extracts the next unclaimed scan itself, so with one loader the two threads share the work.
+/// Each thread has its own extractor. take() hands the scans out in order; a scan that failed
+/// to load rethrows its error there, at its own index, as the single-thread loop would. The
+/// scans and their features live in a fixed ring of depth + 1 slots, each filled again once
 /// the consumer release()s it: no allocation per scan after warm-up.
 class ScanPrefetcher {
  public:
@@ -52,6 +65,7 @@ class ScanPrefetcher {
     FeatureFrame frame;          ///< the scan's features (prefetcher only)
     StageTimes times;            ///< their detect / Cartesian / describe times
     std::string extract_error;   ///< extraction threw: the run stops there, as with one thread
+    size_t ready = 0;            ///< scan index + 1 once filled (guarded by the mutex)
   };
   /// Loads scan i of `folder` into `l`, reusing its buffers, and times it.
   static void loadInto(const ScanFolder& folder, size_t i, Loaded& l) {
@@ -64,30 +78,50 @@ class ScanPrefetcher {
     }
     l.load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
-  ScanPrefetcher(const ScanFolder& folder, size_t depth, const PipelineConfig& config)
-      : folder_(folder), config_(config), extractor_(config.detector, config.features),
-        slots_(std::max<size_t>(1, depth) + 1), thread_([this] { loop(); }) {}
+  ScanPrefetcher(const ScanFolder& folder, size_t depth, size_t workers, const PipelineConfig& config)
+      : folder_(folder), config_(config), workers_(std::max<size_t>(1, workers)),
+        slots_(std::max(std::max<size_t>(1, depth), workers_) + 1) {
+    extractors_.reserve(workers_ + 1);  // the last one: the consumer's
+    for (size_t w = 0; w <= workers_; ++w) extractors_.emplace_back(config.detector, config.features);
+    cpu_ms_.assign(workers_, 0.0);
+    threads_.reserve(workers_);
+    for (size_t w = 0; w < workers_; ++w) threads_.emplace_back([this, w] { loop(w); });
+  }
   ~ScanPrefetcher() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       stop_ = true;
     }
     cv_.notify_all();
-    thread_.join();
+    for (std::thread& t : threads_) t.join();
   }
-  /// The next scan in folder order and its load time (ms); `wait_ms` += time spent waiting.
-  /// Valid until release(), which must be called before the next take().
+  /// CPU time of each loader thread (ms), complete once all scans were taken.
+  std::vector<double> workerCpuMs() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return cpu_ms_;
+  }
+  /// The next scan in folder order and its load time (ms); `wait_ms` += time spent waiting
+  /// (or filling scans itself). Valid until release(), which must be called before the next take().
   Loaded& take(double& wait_ms) {
     const auto t0 = std::chrono::steady_clock::now();
     std::unique_lock<std::mutex> lock(mutex_);
-    cv_.wait(lock, [this] { return loaded_ > taken_; });
     Loaded& item = slots_[taken_ % slots_.size()];
+    while (item.ready != taken_ + 1) {
+      if (claimable()) {  // help rather than wait
+        const size_t i = claimed_++;
+        lock.unlock();
+        fill(i, extractors_.back());
+        lock.lock();
+        continue;
+      }
+      cv_.wait(lock);
+    }
     ++taken_;
     lock.unlock();
     wait_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return item;
   }
-  /// Gives the slot of the last take() back to the loader.
+  /// Gives the slot of the last take() back to the loaders.
   void release() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -97,42 +131,56 @@ class ScanPrefetcher {
   }
 
  private:
-  void loop() {
-    for (size_t i = 0; i < folder_.size(); ++i) {
+  /// An unclaimed scan whose slot is free (mutex held).
+  bool claimable() const { return claimed_ < folder_.size() && claimed_ < released_ + slots_.size(); }
+
+  void loop(size_t w) {
+    for (;;) {
+      size_t i;
       {
         std::unique_lock<std::mutex> lock(mutex_);
-        cv_.wait(lock, [this, i] { return stop_ || i < released_ + slots_.size(); });  // slot i is free
-        if (stop_) return;
+        cv_.wait(lock, [this] { return stop_ || claimed_ >= folder_.size() || claimable(); });
+        if (stop_ || claimed_ >= folder_.size()) return;
+        i = claimed_++;
       }
-      Loaded& l = slots_[i % slots_.size()];  // outside the lock: the consumer may work meanwhile
-      loadInto(folder_, i, l);
-      l.extract_error.clear();
-      if (l.error.empty()) {
-        try {
-          Odometry::extractFeatures(config_, extractor_, l.scan, l.frame, &l.times);
-        } catch (const std::exception& e) {
-          l.extract_error = e.what();
-        }
-      }
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        loaded_ = i + 1;
-      }
-      cv_.notify_all();
+      fill(i, extractors_[w]);  // outside the lock: the consumer may work meanwhile
+      std::lock_guard<std::mutex> lock(mutex_);
+      cpu_ms_[w] = threadCpuMs();
     }
+  }
+
+  /// Loads scan i into its slot and extracts its features, then marks it ready.
+  void fill(size_t i, FeatureExtractor& extractor) {
+    Loaded& l = slots_[i % slots_.size()];
+    loadInto(folder_, i, l);
+    l.extract_error.clear();
+    if (l.error.empty()) {
+      try {
+        Odometry::extractFeatures(config_, extractor, l.scan, l.frame, &l.times);
+      } catch (const std::exception& e) {
+        l.extract_error = e.what();
+      }
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      l.ready = i + 1;
+    }
+    cv_.notify_all();
   }
 
   const ScanFolder& folder_;
   const PipelineConfig config_;
-  FeatureExtractor extractor_;  ///< used by the loader thread only
+  const size_t workers_;
+  std::vector<FeatureExtractor> extractors_;  ///< one per loader, then the consumer's
   std::vector<Loaded> slots_;
   std::mutex mutex_;
   std::condition_variable cv_;
-  size_t loaded_ = 0;    ///< scans [0, loaded_) are in their slots
+  size_t claimed_ = 0;   ///< scans [0, claimed_) are being filled or are ready
   size_t taken_ = 0;     ///< handed to the consumer
-  size_t released_ = 0;  ///< given back: their slots may be loaded into again
+  size_t released_ = 0;  ///< given back: their slots may be filled again
   bool stop_ = false;
-  std::thread thread_;  // last: starts once the members above exist
+  std::vector<double> cpu_ms_;  ///< per loader, as of its last scan
+  std::vector<std::thread> threads_;
 };
 
 void printStageTotals(const StageTimes& t, double load_ms, double wait_ms, bool prefetch, size_t scans,
@@ -212,7 +260,10 @@ void run(OdometryArgs& a) {
   const bool prefetch = a.threads != 1;
   double wait_ms = 0;
   std::optional<ScanPrefetcher> prefetcher;
-  if (prefetch) prefetcher.emplace(folder, 3, cfg);
+  if (prefetch) {  // the main thread (matching, estimation) and threads - 1 loaders
+    const size_t threads = a.threads > 0 ? a.threads : std::max(2u, std::thread::hardware_concurrency());
+    prefetcher.emplace(folder, 3, threads - 1, cfg);
+  }
   ScanPrefetcher::Loaded single;  // one thread: every scan is loaded into this one, reused
   struct ReleaseSlot {  // hands the prefetcher's slot back at the end of each iteration
     ScanPrefetcher* p;
@@ -276,6 +327,11 @@ void run(OdometryArgs& a) {
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   printStageTotals(totals, load_ms, wait_ms, prefetch, folder.size(), wall);
+  if (prefetch) {
+    std::fprintf(stderr, "  thread CPU: main %.0f ms, loaders", threadCpuMs());
+    for (double ms : prefetcher->workerCpuMs()) std::fprintf(stderr, " %.0f", ms);
+    std::fprintf(stderr, " ms\n");
+  }
   if (skipped)
     std::fprintf(stderr, "warning: skipped %zu of %zu scans that could not be read (first: %s)\n",
                  skipped, folder.size(), first_error.c_str());
@@ -307,9 +363,9 @@ SPINRADAR_COMMAND(
                      "Oxford SDK uses 0.0432)")
           ->check(cli::positive());
       app.add_option("--threads", a->threads,
-                     "Worker threads (TBB limit; >1 also reads the next scans and extracts their "
-                     "features in the background); "
-                     "0 = all cores")
+                     "Worker threads (TBB limit; N > 1: N - 1 threads read the next scans and "
+                     "extract their features in the background while the main thread matches "
+                     "and estimates, and extracts too when it would wait); 0 = all cores")
           ->check(cli::atLeast(0));
       app.add_flag("--quiet,-q", a->quiet, "No progress line");
       app.add_option("--tum", a->tum_out,

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# `odometry --threads 2` decodes the next scans and extracts their features (detector, Cartesian
-# image, ORB, keypoint times) on a background thread while the current one is matched and
-# estimated; its outputs (poses, TUM, covariances) must be byte for byte those of --threads 1,
+# `odometry --threads N` (N > 1) decodes the next scans and extracts their features (detector,
+# Cartesian image, ORB, keypoint times) on N - 1 background threads, the main thread helping when
+# it would wait, while the current one is matched and estimated; the outputs (poses, TUM,
+# covariances) of --threads 2 and 3 (scans filled out of order) must be byte for byte those of --threads 1,
 # one row per scan, in scan order: with the defaults, and with options that change extraction
 # (CFAR detector, azimuth peaks, uniform keypoint times) under another estimator.
 # Usage: odometry_threads_identical.sh SPINRADAR_BIN OUT_DIR
@@ -12,14 +13,16 @@ rm -rf "$out"; mkdir -p "$out"
 # run_pair TAG OPTIONS...: --threads 1 and 2 with the same options, outputs compared
 run_pair() {
   local tag="$1"; shift
-  for t in 1 2; do
+  for t in 1 2 3; do
     "$bin" odometry --input "$out/drive" --threads "$t" --quiet --out "$out/poses_${tag}$t.csv" \
       --tum "$out/poses_${tag}$t.tum" --covariance-out "$out/cov_${tag}$t.csv" "$@" \
       2>"$out/odometry_${tag}$t.log"
   done
-  for f in "poses_${tag}%s.csv" "poses_${tag}%s.tum" "cov_${tag}%s.csv"; do
-    a=$(printf "$out/$f" 1); b=$(printf "$out/$f" 2)
-    cmp "$a" "$b" || { echo "FAIL: $a and $b differ"; exit 1; }
+  for t in 2 3; do
+    for f in "poses_${tag}%s.csv" "poses_${tag}%s.tum" "cov_${tag}%s.csv"; do
+      a=$(printf "$out/$f" 1); b=$(printf "$out/$f" "$t")
+      cmp "$a" "$b" || { echo "FAIL: $a and $b differ"; exit 1; }
+    done
   done
   grep -q "waiting for loads" "$out/odometry_${tag}2.log" || { echo "FAIL: --threads 2 did not prefetch"; exit 1; }
   # The features were extracted on the loader thread (their stage rows say so), not by
