@@ -54,6 +54,9 @@ if(EXISTS ${PROJECT_SOURCE_DIR}/src/tools/cmd_odometry.cpp)
   add_test(NAME cli_odometry_threads_identical
     COMMAND bash ${_tt}/odometry_threads_identical.sh ${_cli} ${_out}/threads)
   set_tests_properties(cli_odometry_threads_identical PROPERTIES TIMEOUT 300)
+  # A recording is read at the range bin size its sensor.json states (--range-resolution wins).
+  add_test(NAME cli_odometry_recorded_sensor
+    COMMAND bash ${_tt}/odometry_recorded_sensor.sh ${_cli} ${_out}/recorded_sensor)
   # The grouped YAML form is accepted and overrides the defaults (estimator rigid -> log line).
   add_test(NAME cli_odometry_grouped_config
     COMMAND bash ${_tt}/with_realdata.sh ${SPINRADAR_SHARED_DIR} ${_cli} odometry --input ${SPINRADAR_SHARED_DIR}/realdata/oxford_2019-01-10-14-36-48

@@ -21,6 +21,7 @@
 #include "output_guard.hpp"
 #include "pipeline_options.hpp"
 #include "progress.hpp"
+#include "recording_sensor.hpp"
 #include "spinradar/estimation/odometry.hpp"
 #include "spinradar/features/feature_extractor.hpp"
 #include "spinradar/io/poses_io.hpp"
@@ -209,10 +210,18 @@ void run(OdometryArgs& a) {
   const PipelineConfig cfg = a.pipeline.resolve();
 
   ScanFolderOptions opts;
-  if (a.range_resolution > 0) opts.range_resolution = a.range_resolution;
+  const std::optional<cli::RecordedSensor> recorded = cli::recordedSensor(a.input);
+  if (a.range_resolution > 0) {
+    opts.range_resolution = a.range_resolution;
+  } else if (recorded) {
+    opts.range_resolution = recorded->range_resolution;
+    std::fprintf(stderr, "odometry: range bins of %.6g m from %s\n", recorded->range_resolution,
+                 recorded->path.c_str());
+  }
   const ScanFolder folder(a.input, parseScanFormat(a.format), opts);
   if (folder.empty()) throw std::runtime_error(folder.folder() + ": no scans found");
   std::vector<NamedPath> inputs = cli::scanFolderInputs(folder, "--input");
+  if (recorded) inputs.push_back({recorded->path, "--input"});
   inputs.push_back({a.pipeline.configPath(), "--config"});
   cli::refuseOutputsOverInputs(
       {{a.out, "--out"}, {a.tum_out, "--tum"}, {a.cov_out, "--covariance-out"}}, inputs);
@@ -359,8 +368,8 @@ SPINRADAR_COMMAND(
       app.add_option("--format", a->format, "Scan layout (default: guessed from the folder)")
           ->check(CLI::IsMember({"auto", "oxford", "boreas", "mulran", "radiate"}));
       app.add_option("--range-resolution", a->range_resolution,
-                     "Metres per range bin (default: the format's own; Oxford 0.0438, the "
-                     "Oxford SDK uses 0.0432)")
+                     "Metres per range bin (default: the recording's sensor.json if it has one, "
+                     "else the format's own; Oxford 0.0438, the Oxford SDK uses 0.0432)")
           ->check(cli::positive());
       app.add_option("--threads", a->threads,
                      "Worker threads (TBB limit; N > 1: N - 1 threads read the next scans and "
