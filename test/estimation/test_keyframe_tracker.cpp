@@ -22,18 +22,7 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-SceneOptions options(uint32_t seed = 42) {
-  SceneOptions o;
-  o.landmarks = 1500;
-  o.min_range = 5.0;
-  o.max_range = 200.0;
-  o.range_sigma = 0.03;
-  o.azimuth_sigma = 0.002;
-  o.clutter = 150;
-  o.beta = 0.049;
-  o.seed = seed;
-  return o;
-}
+SceneOptions options(uint32_t seed = 42) { return spinradar::testing::clutteredDopplerScene(seed); }
 
 struct Drive {
   double final_err = 0.0, worst_err = 0.0, final_yaw_err = 0.0, length = 0.0;

@@ -19,18 +19,7 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-SceneOptions options(uint32_t seed) {
-  SceneOptions o;
-  o.landmarks = 1500;
-  o.min_range = 5.0;
-  o.max_range = 200.0;
-  o.range_sigma = 0.03;
-  o.azimuth_sigma = 0.002;
-  o.clutter = 150;
-  o.beta = 0.049;
-  o.seed = seed;
-  return o;
-}
+SceneOptions options(uint32_t seed) { return spinradar::testing::clutteredDopplerScene(seed); }
 
 EstimatorConfig config() {
   EstimatorConfig c;

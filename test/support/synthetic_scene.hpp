@@ -38,6 +38,21 @@ struct SceneOptions {
   double velocity_shift = 0.0;
 };
 
+/// A dense scene with noisy keypoints, unmatched clutter and Doppler (beta of a CIR204-H):
+/// what the estimator tests of refinement, keyframes and pair recovery run on.
+inline SceneOptions clutteredDopplerScene(uint32_t seed) {
+  SceneOptions o;
+  o.landmarks = 1500;
+  o.min_range = 5.0;
+  o.max_range = 200.0;
+  o.range_sigma = 0.03;
+  o.azimuth_sigma = 0.002;
+  o.clutter = 150;
+  o.beta = 0.049;
+  o.seed = seed;
+  return o;
+}
+
 /// Wraps to (-pi, pi].
 inline double wrapPi(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
