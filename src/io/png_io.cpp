@@ -60,6 +60,11 @@ cv::Mat readPngGray8(const std::string& path) {
   size_t len = 0;
   const int e1 = spng_decoded_image_size(ctx.get(), SPNG_FMT_G8, &len);
   if (e1 != 0 || len != size_t(h.width) * h.height) throw std::runtime_error(unreadable(path, spng_strerror(e1)));
+  // The header alone sets the size: refuse one no radar scan has before allocating for it.
+  constexpr size_t kMaxImageBytes = size_t(1) << 30;
+  if (len > kMaxImageBytes)
+    throw std::runtime_error(path + ": the header says " + std::to_string(h.width) + " x " +
+                             std::to_string(h.height) + " pixels, more than 1 GiB: not a radar scan");
   slow.resize(len);
   const int e2 = spng_decode_image(ctx.get(), slow.data(), len, SPNG_FMT_G8, 0);
   if (e2 != 0) throw std::runtime_error(unreadable(path, spng_strerror(e2)));
