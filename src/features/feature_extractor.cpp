@@ -8,9 +8,17 @@
 
 namespace spinradar {
 
+namespace {
+CartesianProjector makeProjector(const FeatureConfig& f, std::shared_ptr<CartesianTableCache> tables) {
+  if (tables && tables->resolution() == f.cart_resolution && tables->width() == f.cart_pixel_width)
+    return CartesianProjector(std::move(tables));
+  return CartesianProjector(f.cart_resolution, f.cart_pixel_width);
+}
+}  // namespace
+
 struct FeatureExtractor::Impl {
-  Impl(const DetectorConfig& d, const FeatureConfig& f)
-      : detector_config(d), detector(d), projector(f.cart_resolution, f.cart_pixel_width),
+  Impl(const DetectorConfig& d, const FeatureConfig& f, std::shared_ptr<CartesianTableCache> tables)
+      : detector_config(d), detector(d), projector(makeProjector(f, std::move(tables))),
         orb(f.orb_patch_size), features(f) {}
   DetectorConfig detector_config;
   Detector detector;
@@ -21,10 +29,14 @@ struct FeatureExtractor::Impl {
   std::vector<float> scratch;
 };
 
-FeatureExtractor::FeatureExtractor(const DetectorConfig& detector, const FeatureConfig& features) {
+FeatureExtractor::FeatureExtractor(const DetectorConfig& detector, const FeatureConfig& features)
+    : FeatureExtractor(detector, features, nullptr) {}
+
+FeatureExtractor::FeatureExtractor(const DetectorConfig& detector, const FeatureConfig& features,
+                                   std::shared_ptr<CartesianTableCache> tables) {
   detector.validate();
   features.validate();
-  impl_ = std::make_unique<Impl>(detector, features);
+  impl_ = std::make_unique<Impl>(detector, features, std::move(tables));
 }
 
 FeatureExtractor::~FeatureExtractor() = default;
@@ -64,6 +76,10 @@ void FeatureExtractor::extract(const PolarScan& scan, FeatureFrame& out, StageTi
 }
 
 const cv::Mat& FeatureExtractor::cartesianImage() const { return impl_->cart; }
+
+const std::shared_ptr<CartesianTableCache>& FeatureExtractor::cartesianTables() const {
+  return impl_->projector.tables();
+}
 
 void FeatureExtractor::setAzimuthPeaks(bool on) {
   impl_->detector_config.azimuth_peaks = on;

@@ -53,10 +53,13 @@ struct OdometryArgs {
 /// of the CPU per scan) overlap matching and estimation of the current one. Scans are claimed
 /// in order by whichever thread is free, the consumer included: while take() waits it loads and
 /// extracts the next unclaimed scan itself, so with one loader the two threads share the work.
-/// Each thread has its own extractor. take() hands the scans out in order; a scan that failed
-/// to load rethrows its error there, at its own index, as the single-thread loop would. The
-/// scans and their features live in a fixed ring of depth + 1 slots, each filled again once
-/// the consumer release()s it: no allocation per scan after warm-up.
+/// Each thread has its own extractor (working buffers), all sharing one set of read-only
+/// Cartesian tables, built once from the first scan as with one thread: the other scans wait
+/// for the first scan's features before extracting theirs. take() hands the scans out in
+/// order; a scan that failed to load rethrows its error there, at its own index, as the
+/// single-thread loop would. The scans and their features live in a fixed ring of depth + 1
+/// slots, each filled again once the consumer release()s it: no allocation per scan after
+/// warm-up.
 class ScanPrefetcher {
  public:
   struct Loaded {
@@ -83,7 +86,9 @@ class ScanPrefetcher {
       : folder_(folder), config_(config), workers_(std::max<size_t>(1, workers)),
         slots_(std::max(std::max<size_t>(1, depth), workers_) + 1) {
     extractors_.reserve(workers_ + 1);  // the last one: the consumer's
-    for (size_t w = 0; w <= workers_; ++w) extractors_.emplace_back(config.detector, config.features);
+    for (size_t w = 0; w <= workers_; ++w)
+      extractors_.emplace_back(config.detector, config.features,
+                               w == 0 ? nullptr : extractors_.front().cartesianTables());
     cpu_ms_.assign(workers_, 0.0);
     threads_.reserve(workers_);
     for (size_t w = 0; w < workers_; ++w) threads_.emplace_back([this, w] { loop(w); });
@@ -155,6 +160,10 @@ class ScanPrefetcher {
     Loaded& l = slots_[i % slots_.size()];
     loadInto(folder_, i, l);
     l.extract_error.clear();
+    if (i > 0) {  // the tables come from the first scan, as with one thread (jitter is tolerated)
+      std::unique_lock<std::mutex> lock(mutex_);
+      cv_.wait(lock, [this] { return first_done_ || stop_; });
+    }
     if (l.error.empty()) {
       try {
         Odometry::extractFeatures(config_, extractor, l.scan, l.frame, &l.times);
@@ -165,6 +174,7 @@ class ScanPrefetcher {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       l.ready = i + 1;
+      if (i == 0) first_done_ = true;
     }
     cv_.notify_all();
   }
@@ -180,6 +190,7 @@ class ScanPrefetcher {
   size_t taken_ = 0;     ///< handed to the consumer
   size_t released_ = 0;  ///< given back: their slots may be filled again
   bool stop_ = false;
+  bool first_done_ = false;  ///< scan 0 is filled (its features built the Cartesian tables)
   std::vector<double> cpu_ms_;  ///< per loader, as of its last scan
   std::vector<std::thread> threads_;
 };

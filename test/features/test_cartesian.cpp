@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <thread>
 
 #include <opencv2/core.hpp>
 
@@ -121,6 +122,49 @@ TEST(Cartesian, TablesAreCachedPerGeometry) {
   proj.setImageGeometry(0.25, 200);
   proj.render(fewer, img);
   EXPECT_EQ(proj.tableBuilds(), 4);
+}
+
+TEST(Cartesian, SharedTablesAreBuiltOnceForAllThreads) {
+  PolarScan s = emptyScan();
+  std::mt19937 rng(4);
+  std::uniform_int_distribution<int> u(0, 255);
+  for (auto& p : s.power) p = static_cast<uint8_t>(u(rng));
+  CartesianProjector solo;
+  cv::Mat want;
+  solo.render(s, want);
+  // Four projectors on four threads, one table cache: one build, the same tables, the same image.
+  auto shared = std::make_shared<CartesianTableCache>(0.2592, 964);
+  std::vector<CartesianProjector> projectors(4, CartesianProjector(shared));
+  std::vector<cv::Mat> images(projectors.size());
+  std::vector<std::thread> threads;
+  for (size_t t = 0; t < projectors.size(); ++t)
+    threads.emplace_back([&, t] { projectors[t].render(s, images[t]); });
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(shared->builds(), 1);
+  int builds = 0;
+  for (size_t t = 0; t < projectors.size(); ++t) {
+    builds += projectors[t].tableBuilds();
+    EXPECT_EQ(projectors[t].remap(), projectors[0].remap());
+    EXPECT_EQ(cv::norm(images[t], want, cv::NORM_INF), 0.0) << "thread " << t;
+  }
+  EXPECT_EQ(builds, 1);
+  // One encoder count of jitter keeps the shared tables; a new geometry is built once more,
+  // and the projector still holding the old tables may keep using them.
+  PolarScan jitter = s;
+  for (auto& a : jitter.azimuth) a += 2 * M_PI / 5600;
+  projectors[1].render(jitter, images[1]);
+  EXPECT_EQ(shared->builds(), 1);
+  PolarScan shifted = s;
+  for (auto& a : shifted.azimuth) a += 0.5 * 2 * M_PI / 400;
+  projectors[2].render(shifted, images[2]);
+  projectors[3].render(shifted, images[3]);
+  EXPECT_EQ(shared->builds(), 2);
+  EXPECT_EQ(projectors[3].remap(), projectors[2].remap());
+  projectors[0].render(s, images[0]);
+  EXPECT_EQ(cv::norm(images[0], want, cv::NORM_INF), 0.0);
+  // Another image geometry gets tables of its own.
+  projectors[0].setImageGeometry(0.5, 200);
+  EXPECT_NE(projectors[0].tables(), shared);
 }
 
 TEST(Cartesian, InvalidRowsDoNotLeaveGapsAndFarPixelsAreBlack) {

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "support/count_allocations.hpp"
 #include "support/feature_test_utils.hpp"
@@ -95,6 +96,35 @@ TEST(FeatureExtractor, RecoversKnownMotionOnSyntheticScans) {
               f1.keypoints.size(), f2.keypoints.size(), m.size(), 100 * agree);
   EXPECT_GT(m.size(), 100u);
   EXPECT_GT(agree, 0.7);  // plenty for RANSAC; the rest are mostly look-alike isolated points
+}
+
+TEST(FeatureExtractor, ExtractorsOnSeveralThreadsShareOneSetOfTables) {
+  const Motion mo{1.5, -0.3, 0.03};
+  std::vector<Target> t1, t2;
+  makeScene(mo, t1, t2, 8);
+  const std::vector<PolarScan> scans = {test::syntheticScan(t1, 1), test::syntheticScan(t2, 2)};
+  FeatureExtractor solo(DetectorConfig{}, FeatureConfig{});
+  std::vector<FeatureFrame> want(2);
+  for (size_t i = 0; i < 2; ++i) solo.extract(scans[i], want[i]);
+  FeatureExtractor first(DetectorConfig{}, FeatureConfig{});
+  FeatureExtractor second(DetectorConfig{}, FeatureConfig{}, first.cartesianTables());
+  ASSERT_EQ(second.cartesianTables(), first.cartesianTables());
+  std::vector<FeatureFrame> got(2);
+  std::thread a([&] { first.extract(scans[0], got[0]); });
+  std::thread b([&] { second.extract(scans[1], got[1]); });
+  a.join();
+  b.join();
+  EXPECT_EQ(first.cartesianTables()->builds(), 1);  // one build for both threads
+  for (size_t i = 0; i < 2; ++i) {
+    ASSERT_EQ(got[i].keypoints.size(), want[i].keypoints.size());
+    ASSERT_GT(got[i].keypoints.size(), 300u);
+    EXPECT_EQ(cv::norm(got[i].descriptors, want[i].descriptors, cv::NORM_HAMMING), 0) << "scan " << i;
+  }
+  // Tables of another image geometry are not taken.
+  FeatureConfig other;
+  other.cart_pixel_width = 500;
+  FeatureExtractor third(DetectorConfig{}, other, first.cartesianTables());
+  EXPECT_NE(third.cartesianTables(), first.cartesianTables());
 }
 
 TEST(FeatureExtractor, StampIsFirstValidAzimuthAndMaxKeypointsKeepsStrongest) {

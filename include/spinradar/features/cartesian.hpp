@@ -1,11 +1,13 @@
 #pragma once
 // Polar scan -> square Cartesian image (sensor at the centre, x forward = up, y left = left).
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
 
 #include "spinradar/core/polar_scan.hpp"
+#include "spinradar/features/cartesian_tables.hpp"
 #include "spinradar/features/huge_page_allocator.hpp"
 
 namespace spinradar {
@@ -19,7 +21,9 @@ namespace spinradar {
 /// (an azimuth angle by more than 10 % of an azimuth step, i.e. < 0.8 px at 125 m for 400
 /// azimuths: one encoder count of jitter does not trigger it). A rebuild for new angles costs a
 /// few ms (per-pixel range and angle are kept per image geometry; angle -> row goes through a
-/// 65536-entry table). Pixels beyond the last bin are 0.
+/// 65536-entry table). Pixels beyond the last bin are 0. The tables live in a
+/// CartesianTableCache (cartesian_tables.hpp), read only, which projectors on several threads
+/// may share: they are then built once for all of them.
 ///
 /// Pixel convention (as the Oxford SDK): pixel centres at integer (col, row), the sensor at
 /// ((W-1)/2, (W-1)/2); a point (x, y) of the REP 103 sensor frame is at
@@ -27,7 +31,11 @@ namespace spinradar {
 class CartesianProjector {
  public:
   explicit CartesianProjector(double resolution = 0.2592, int width = 964);
+  /// Renders with the tables of `tables` (its image geometry), shared with other projectors.
+  explicit CartesianProjector(std::shared_ptr<CartesianTableCache> tables);
+  /// A new geometry gets tables of its own (no longer shared).
   void setImageGeometry(double resolution, int width);
+  const std::shared_ptr<CartesianTableCache>& tables() const { return cache_; }
 
   /// Renders `scan` into `image` (CV_8UC1, width x width, bilinear). `extra_range_offset` is
   /// added to scan.range_offset (the detector's range_offset, so image and keypoints agree).
@@ -50,18 +58,19 @@ class CartesianProjector {
 
   double resolution() const { return resolution_; }
   int width() const { return width_; }
-  int tableBuilds() const { return builds_; }  ///< how many times the remap tables were built
+  /// How many times this projector built remap tables (not counting those it got built by
+  /// another projector sharing its tables).
+  int tableBuilds() const { return builds_; }
+  /// The remap tables of the last render (null before the first).
+  const std::shared_ptr<const CartesianRemap>& remap() const { return remap_; }
   /// Per pixel (row-major): range (m) of its centre and clockwise angle from forward in
-  /// 1/65536 turns, from which the tables are built.
+  /// 1/65536 turns, from which the tables are built (built on first use).
   template <class T>
-  using Table = std::vector<T, HugePageAllocator<T>>;
-  const Table<float>& pixelRanges() const { return pixel_range_; }
-  const Table<uint16_t>& pixelAngles() const { return pixel_angle_; }
+  using Table = HugePageVector<T>;
+  const Table<float>& pixelRanges() const { return cache_->pixels()->range; }
+  const Table<uint16_t>& pixelAngles() const { return cache_->pixels()->angle; }
 
  private:
-  bool geometryChanged(const PolarScan& scan, double offset) const;
-  void buildPixelGeometry();
-  void buildTables(const PolarScan& scan, double offset);
   void remapRows(uint8_t* image, size_t image_step) const;
 
   double resolution_ = 0.2592;
@@ -69,18 +78,8 @@ class CartesianProjector {
   double centre_ = 481.5;
   int builds_ = 0;
   bool use_simd_ = true;
-  // geometry the tables were built for
-  int azimuths_ = -1, bins_ = -1;
-  double range_resolution_ = 0, offset_ = 0;
-  std::vector<double> angles_;
-  int box_ = 1;  ///< range bins averaged per pixel
-  // per image geometry: range (m) and angle (clockwise, 1/65536 turns) of every pixel
-  Table<float> pixel_range_;
-  Table<uint16_t> pixel_angle_;
-  std::vector<uint32_t> angle_row_;  ///< 65536 entries: (row << 8) | weight of the next row
-  // tables and scratch
-  Table<uint32_t> offset_table_;  ///< per pixel: index of its (row, bin) in polar_
-  std::vector<uint8_t> weight_table_;   ///< per pixel: weight of the next row, /256
+  std::shared_ptr<CartesianTableCache> cache_;
+  std::shared_ptr<const CartesianRemap> remap_;  ///< tables of the current scan geometry
   Table<uint8_t> polar_;  ///< (azimuths + 3) x bins: smoothed rows, row 0 again (wrap), 2 zero rows
 };
 

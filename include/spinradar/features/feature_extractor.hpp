@@ -11,9 +11,16 @@
 
 namespace spinradar {
 
+class CartesianTableCache;
+
 class FeatureExtractor {
  public:
   FeatureExtractor(const DetectorConfig& detector, const FeatureConfig& features);
+  /// Shares the read-only Cartesian tables of `tables` (see cartesianTables()) when they have
+  /// this config's image geometry, so that extractors on several threads build them once;
+  /// otherwise (or when null) builds its own. Each extractor keeps its own working buffers.
+  FeatureExtractor(const DetectorConfig& detector, const FeatureConfig& features,
+                   std::shared_ptr<CartesianTableCache> tables);
   ~FeatureExtractor();
   FeatureExtractor(FeatureExtractor&&) noexcept;
   FeatureExtractor& operator=(FeatureExtractor&&) noexcept;
@@ -26,6 +33,9 @@ class FeatureExtractor {
   /// The Cartesian image of the last extracted scan (CV_8U, cart_pixel_width square,
   /// sensor at the centre, x forward = up, y left = left). For debug display.
   const cv::Mat& cartesianImage() const;
+
+  /// The Cartesian projector's tables (thread-safe, read only once built), to share.
+  const std::shared_ptr<CartesianTableCache>& cartesianTables() const;
 
   /// Overrides DetectorConfig::azimuth_peaks (keypoints at azimuthal peaks, sub-row azimuths).
   void setAzimuthPeaks(bool on);
