@@ -4,7 +4,8 @@
 // Three curves over range (4 nodes each, sensor_config.hpp) are fitted so that the per-band
 // realism figures (mean, q90, plain CA-CFAR cells, Cen2018 keypoints) of the re-simulated
 // reference scene match the recording's: Levenberg-Marquardt on log figures, the Jacobian from
-// a re-simulation with each of the 12 nodes nudged.
+// a re-simulation with each of the 12 nodes nudged. Figures that measure the reference scene's
+// geometry rather than the sensor (sceneDependentFigures) are left out of the fit.
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -63,6 +64,9 @@ void setParam(SensorConfig& s, int type, int j, double p) {
   }
 }
 
+const char* const kFigureNames[kPerBand] = {"mean", "q90", "cacfar", "cen2018"};
+
+// Scene-dependent figures weigh nothing: their rows of the residual and the Jacobian are zero.
 Eigen::VectorXd logFigures(const sim::RealismStats& st) {
   Eigen::VectorXd v(kRows);
   for (int k = 0; k < kBands; ++k) {
@@ -70,11 +74,53 @@ Eigen::VectorXd logFigures(const sim::RealismStats& st) {
     v[kPerBand * k + 1] = std::log(1 + st.band_q90[k]);
     v[kPerBand * k + 2] = std::log(1 + st.band_cacfar[k]);
     v[kPerBand * k + 3] = std::log(1 + std::max(st.band_cen[k], 0.0));
+    for (int i = 0; i < kPerBand; ++i)
+      if (isSceneDependent(k, kFigureNames[i])) v[kPerBand * k + i] = 0;
   }
   return v;
 }
 
 }  // namespace
+
+const std::vector<SceneDependentFigure>& sceneDependentFigures() {
+  // test/sim/test_near_band.cpp: going from the reference city scene's street (walls at 4-8 m
+  // on both sides) to the Oxford sample's (one side beyond 10 m) moves every 2.5-10 m figure by
+  // 40-70 %, 2.7x (mean) to 6x (q90, Cen2018) what a 6 dB sensor change at the 5 m node does;
+  // a wall gives about one Cen2018 keypoint per azimuth row that sees it within 10 m whatever
+  // the noise or the returns' level. Fitted, the 5 m nodes went to their bounds to make up for
+  // the street (MulRan receiver -27 dB, clutter 1/64 at 5 m).
+  static const std::string why =
+      "the 2.5-10 m band shows the street's own walls and parked cars: it measures the street "
+      "width of the scene (reference city scene: walls at 4-8 m on both sides), not the sensor";
+  static const std::vector<SceneDependentFigure> f = {
+      {0, "mean", why}, {0, "q90", why}, {0, "cacfar", why}, {0, "cen2018", why}};
+  return f;
+}
+
+bool isSceneDependent(int band, const std::string& figure) {
+  for (const auto& f : sceneDependentFigures())
+    if (f.band == band && f.figure == figure) return true;
+  return false;
+}
+
+std::vector<std::pair<std::string, double>> fittedBandGaps(const sim::RealismStats& sim,
+                                                           const sim::RealismStats& real) {
+  static const char* const band_names[kBands] = {"2.5-10 m", "10-25 m", "25-50 m", "50-100 m"};
+  std::vector<std::pair<std::string, double>> g;
+  for (int k = 0; k < kBands; ++k) {
+    const double s[kPerBand] = {sim.band_mean[k], sim.band_q90[k], sim.band_cacfar[k],
+                                sim.band_cen[k]};
+    const double r[kPerBand] = {real.band_mean[k], real.band_q90[k], real.band_cacfar[k],
+                                real.band_cen[k]};
+    for (int i = 0; i < kPerBand; ++i) {
+      if (isSceneDependent(k, kFigureNames[i])) continue;
+      if (i == 3 && (s[i] < 0 || r[i] < 0)) continue;  // detectors not run
+      g.emplace_back(std::string(band_names[k]) + " " + kFigureNames[i],
+                     r[i] > 0 ? std::abs(s[i] - r[i]) / r[i] : (s[i] > 0 ? 1.0 : 0.0));
+    }
+  }
+  return g;
+}
 
 sim::RealismStats realismOf(const SensorConfig& s, const sim::PhysicsConfig& physics,
                             const AppearanceOptions& opt, uint64_t seed, const std::string& name) {

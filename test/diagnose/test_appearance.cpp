@@ -83,6 +83,10 @@ INSTANTIATE_TEST_SUITE_P(
              [](sim::SensorConfig& s, sim::PhysicsConfig&, double) { s.range_gain_db_per_decade -= 5; }},
         Case{"noise_floor", "noise_floor_db", 11.0, 1.0,
              [](sim::SensorConfig& s, sim::PhysicsConfig&, double) { s.noise_floor_db += 3; }},
+        // Boreas-RT-like native level, beyond the Newton steps' trust region (2 x 6 dB here):
+        // reached through the level pre-alignment.
+        Case{"noise_floor_25dB", "noise_floor_db", 33.0, 1.0,
+             [](sim::SensorConfig& s, sim::PhysicsConfig&, double) { s.noise_floor_db += 25; }},
         Case{"saturation", "saturation", 0, 1.0,
              [](sim::SensorConfig& s, sim::PhysicsConfig&, double top) { s.saturation = top - 20; }},
         Case{"ghosts", "multipath", -15.0, 1.5,

@@ -29,14 +29,15 @@ AppearanceOptions quick() {
   return o;
 }
 
-// Worst relative per-band gap over the figures the recording has enough of: a count below
-// 30 per scan (a few scans) is dominated by its own Poisson scatter.
+// Worst relative per-band gap over the fitted figures the recording has enough of: a count
+// below 30 per scan (a few scans) is dominated by its own Poisson scatter.
 double worstGap(const sim::RealismStats& s, const sim::RealismStats& r) {
   double w = 0;
   auto rel = [&](double a, double b) {
     if (b >= 30) w = std::max(w, std::abs(a - b) / b);
   };
   for (int k = 0; k < 4; ++k) {
+    if (isSceneDependent(k, "mean")) continue;  // the whole near band (test_near_band.cpp)
     rel(s.band_mean[k] * 30, r.band_mean[k] * 30);
     rel(s.band_q90[k] * 30, r.band_q90[k] * 30);
     rel(s.band_cacfar[k], r.band_cacfar[k]);
@@ -83,13 +84,26 @@ TEST(AppearanceBands, CurvesActWhereSet) {
   EXPECT_GT(up.band_mean[3] - base.band_mean[3], 3.0);    // mostly at 71 m
 }
 
+// What a wider street does to the recording (test/sim/test_near_band.cpp, one side at 6 m and
+// the other at 11 m instead of 6 m): the 2.5-10 m figures change, nothing else.
+sim::RealismStats widerStreet(sim::RealismStats r) {
+  r.band_mean[0] *= 0.55;
+  r.band_q90[0] *= 0.3;
+  r.band_cacfar[0] *= 0.6;
+  r.band_cen[0] *= 0.5;
+  return r;
+}
+
 TEST(AppearanceBands, ConcealedRangeCurvesFitted) {
   sim::SensorConfig truth = baseSensor();
   truth.stc_curve_db_35m = 5.0;       // receiver gain bump at 25-50 m
-  truth.return_gain_db_5m = -6.0;     // near returns dimmer (elevation pattern)
+  truth.return_gain_db_71m = -6.0;    // far returns dimmer (elevation pattern)
   truth.clutter_density_x_16m = 3.0;  // more clutter at 10-25 m
   const auto rec = renderReference(truth, {}, quick(), 4242);  // not the fit's seed
-  const auto real = sim::computeRealism(rec, "recording");
+  // The recording's street is wider than the reference scene's: the scene-dependent figure
+  // differs, the sensor change must still come back.
+  for (const char* f : {"mean", "q90", "cacfar", "cen2018"}) ASSERT_TRUE(isSceneDependent(0, f));
+  const auto real = widerStreet(sim::computeRealism(rec, "recording"));
   const AppearanceOptions opt = quick();
   const auto before = realismOf(baseSensor(), {}, opt, opt.seed + 1, "before");
   std::vector<std::string> steps;
@@ -103,6 +117,24 @@ TEST(AppearanceBands, ConcealedRangeCurvesFitted) {
   // density as a ratio).
   EXPECT_NEAR(fitted.stc_curve_db_35m, 5.0, 1.5);
   EXPECT_GT(fitted.clutter_density_x_16m / std::max(fitted.clutter_density_x_35m, 1e-3), 1.8);
+  // Left out, not fitted: the near-band gaps stay what the street makes them.
+  EXPECT_GT(after.band_q90[0] / real.band_q90[0], 2.0);
+  for (const auto& [name, gap] : fittedBandGaps(after, real))
+    EXPECT_EQ(name.find("2.5-10 m"), std::string::npos) << name;
+}
+
+// A scene-dependent figure cannot drive the fit: the street width of the recording (any value
+// of that figure) leaves every fitted curve exactly as it is.
+TEST(AppearanceBands, SceneDependentFigureCannotDriveTheFit) {
+  sim::SensorConfig truth = baseSensor();
+  truth.stc_curve_db_16m = 4.0;
+  const auto real = sim::computeRealism(renderReference(truth, {}, quick(), 4243), "recording");
+  AppearanceOptions opt = quick();
+  opt.curve_iterations = 2;
+  const sim::SensorConfig a = fitRangeCurves(real, baseSensor(), {}, opt);
+  const sim::SensorConfig b = fitRangeCurves(widerStreet(real), baseSensor(), {}, opt);
+  EXPECT_NE(a.toJson(), baseSensor().toJson());  // the fit moved
+  EXPECT_EQ(a.toJson(), b.toJson());
 }
 
 }  // namespace

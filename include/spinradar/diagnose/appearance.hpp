@@ -7,6 +7,7 @@
 // (figure Jacobian from re-simulations with each parameter nudged). Method: docs/diagnose.md.
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -90,6 +91,22 @@ struct AppearanceOptions {
   bool holdout = true;
 };
 
+/// A per-band realism figure that measures the reference scene's geometry rather than the
+/// sensor: left out of the per-band fit (fitRangeCurves) and of the worst-gap figures, and
+/// reported separately as "scene-dependent, not fitted" with its reason.
+struct SceneDependentFigure {
+  int band;            ///< 0..3 (sim::kBandEdges)
+  std::string figure;  ///< "mean", "q90", "cacfar" or "cen2018"
+  std::string reason;
+};
+const std::vector<SceneDependentFigure>& sceneDependentFigures();
+bool isSceneDependent(int band, const std::string& figure);
+
+/// Relative per-band gaps |sim - real| / real of the figures the fit uses (sim::bandGaps without
+/// the scene-dependent ones), with their names ("25-50 m q90").
+std::vector<std::pair<std::string, double>> fittedBandGaps(const sim::RealismStats& sim,
+                                                           const sim::RealismStats& real);
+
 struct AppearanceReport {
   std::vector<AppearanceFinding> findings;  ///< named first (largest z), then the rest
   std::vector<AppearanceLocate> locate;
@@ -100,8 +117,10 @@ struct AppearanceReport {
   /// Realism figures of the recording's fit part (realism_real) and held-out part, and of the
   /// reference scene re-simulated with the base and the fitted model (another noise seed).
   sim::RealismStats realism_real, realism_holdout, realism_before, realism_after;
-  double worst_gap_before = 0, worst_gap_after = 0;  ///< per-band realism gap (relative), fit part
-  double worst_holdout_before = 0, worst_holdout_after = 0;  ///< the same on the held-out part
+  /// Worst per-band realism gap (relative) over the fitted figures (scene-dependent ones left
+  /// out), fit part and held-out part.
+  double worst_gap_before = 0, worst_gap_after = 0;
+  double worst_holdout_before = 0, worst_holdout_after = 0;
   int fit_scans = 0, holdout_scans = 0;  ///< scans (or masked half scans) in each part
   double runtime_s = 0;
   nlohmann::json toJson() const;

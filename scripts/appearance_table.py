@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+"""Before/after realism table of the calibrated sensors (README "Calibrated sensors",
+docs/diagnose.md) from the appearance reports scripts/calibrate_sensors.sh writes.
+
+Usage: scripts/appearance_table.py OUT   (OUT/<sample>/appearance/appearance.json)
+Prints a markdown table (real fit part / real held out / sim before / sim after per sample) and,
+per sample and part, the fitted figures still over 15 % after the fit.
+"""
+import json
+import os
+import sys
+
+SAMPLES = [("oxford", "Oxford CTS350-X"), ("mulran", "MulRan CIR204-H"),
+           ("boreas_rt", "Boreas-RT RAS6"), ("radiate", "RADIATE*")]
+BANDS = ["2.5-10 m", "10-25 m", "25-50 m", "50-100 m"]
+FIGS = ["mean", "q90", "cacfar", "cen2018"]
+
+
+def load(out, name):
+    path = os.path.join(out, name, "appearance", "appearance.json")
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError) as e:
+        sys.exit(f"{path}: cannot read the appearance report ({e})")
+
+
+def scene_dependent(j):
+    return {(d["band"], d["figure"]) for d in j.get("scene_dependent_not_fitted", [])}
+
+
+def gaps(j, part, col):
+    """Relative gaps |sim - real| / real of the fitted figures, by name."""
+    rb, skip, g = j["realism_bands"], scene_dependent(j), {}
+    for k, band in enumerate(BANDS):
+        for f in FIGS:
+            if (k, f) in skip:
+                continue
+            r, s = rb[part][f][k], rb[col][f][k]
+            if r < 0 or s < 0:
+                continue
+            g[f"{band} {f}"] = abs(s - r) / r if r > 0 else (1.0 if s > 0 else 0.0)
+    return g
+
+
+def worst(g, far_only=False):
+    v = [x for n, x in g.items() if not far_only or not n.startswith("2.5-10")]
+    return 100 * max(v) if v else float("nan")
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    reps = [(label, load(sys.argv[1], name)) for name, label in SAMPLES]
+    parts = [("recording_fit", "fit part"), ("recording_holdout", "held-out part")]
+    print("| figure: real fit part / real held out / sim before / sim after | " +
+          " | ".join(label for label, _ in reps) + " |")
+    print("|---" * (len(reps) + 1) + "|")
+
+    def quad(j, f, bands):
+        rb = j["realism_bands"]
+        cols = ["recording_fit", "recording_holdout", "sim_before", "sim_after"]
+        return " / ".join(f"{sum(rb[c][f][k] for k in bands):.0f}" if c in rb else "-"
+                          for c in cols)
+
+    print("| Cen2018 keypoints/scan, 10-100 m | " +
+          " | ".join(quad(j, "cen2018", [1, 2, 3]) for _, j in reps) + " |")
+    print("| Cen2018 keypoints/scan, 2.5-10 m (scene-dependent, not fitted) | " +
+          " | ".join(quad(j, "cen2018", [0]) for _, j in reps) + " |")
+    print("| plain CA-CFAR cells/scan, 2.5-100 m | " +
+          " | ".join(quad(j, "cacfar", [0, 1, 2, 3]) for _, j in reps) + " |")
+    for part, what in parts:
+        cells = []
+        for _, j in reps:
+            if part not in j["realism_bands"]:
+                cells.append("-")
+                continue
+            b, a = gaps(j, part, "sim_before"), gaps(j, part, "sim_after")
+            cells.append(f"{worst(b):.0f} % -> {worst(a):.0f} %")
+        print(f"| worst per-band gap, fitted figures (15 of 16), {what} | " + " | ".join(cells) + " |")
+    for part, what in parts:
+        cells = []
+        for _, j in reps:
+            if part not in j["realism_bands"]:
+                cells.append("-")
+                continue
+            b, a = gaps(j, part, "sim_before"), gaps(j, part, "sim_after")
+            cells.append(f"{worst(b, True):.0f} % -> {worst(a, True):.0f} %")
+        print(f"| the same at 10-100 m (12 figures), {what} | " + " | ".join(cells) + " |")
+    print()
+    for (name, label), (_, j) in zip(SAMPLES, reps):
+        for part, what in parts:
+            if part not in j["realism_bands"]:
+                continue
+            over = sorted(((n, x) for n, x in gaps(j, part, "sim_after").items() if x > 0.15),
+                          key=lambda t: -t[1])
+            text = ", ".join(f"{n} {100 * x:.0f} %" for n, x in over) or "none"
+            print(f"- {label}, {what}: over 15 %: {text}")
+
+
+if __name__ == "__main__":
+    main()
