@@ -52,6 +52,7 @@ endif()
 target_link_libraries(driver_test_navtech_realdata PRIVATE spinradar_io)
 target_link_libraries(io_test_ground_truth_io PRIVATE spinradar_evaluation)
 target_link_libraries(features_test_feature_extractor PRIVATE spinradar_io)
+target_link_libraries(features_test_gaussian_blur PRIVATE spinradar_io)
 # Tests that write or read images with OpenCV to check the project's own PNG code against it.
 foreach(t io_test_scan_io io_test_bad_scans evaluation_test_plot sim_test_png_decode)
   if(TARGET ${t})

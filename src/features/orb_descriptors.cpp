@@ -6,7 +6,6 @@
 #include <stdexcept>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
 
 namespace spinradar {
 
@@ -90,14 +89,11 @@ void OrbDescriber::describe(const cv::Mat& image, const CartesianProjector& proj
     describeWithOpenCv(image, projector, keypoints, descriptors);
     return;
   }
-  // Blur exactly as cv::ORB does: a copy with a reflected border of ORB's width, then the same
-  // GaussianBlur call on the image inside it (the border supplies the neighbours).
-  const int border = std::max(patch_size_, std::max(static_cast<int>(std::ceil(half * std::sqrt(2.0))), 4)) + 1;
-  bordered_.create(H + 2 * border, (W + 2 * border + 15) & ~15, CV_8UC1);
-  cv::Mat ext = bordered_(cv::Rect(0, 0, W + 2 * border, H + 2 * border));
-  cv::copyMakeBorder(image, ext, border, border, border, border, cv::BORDER_REFLECT_101);
-  cv::Mat blurred = ext(cv::Rect(border, border, W, H));
-  cv::GaussianBlur(blurred, blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+  // Blur as cv::ORB does: it blurs inside a copy with a reflected border, which gives the same
+  // bytes as blurring the image with reflected borders (and the descriptors only read pixels a
+  // patch away from the edges anyway).
+  blur_.apply(image, blurred_);
+  const cv::Mat& blurred = blurred_;
 
   const int step = static_cast<int>(blurred.step);
   if (offsets_step_ != blurred.step) {

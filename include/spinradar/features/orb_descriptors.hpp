@@ -6,15 +6,17 @@
 #include <opencv2/features2d.hpp>
 
 #include "spinradar/features/cartesian.hpp"
+#include "spinradar/features/gaussian_blur.hpp"
 #include "spinradar/core/feature_frame.hpp"
 
 namespace spinradar {
 
 /// Gives exactly cv::ORB::compute's descriptors (one level, WTA_K 2, edge threshold = patch
 /// size; tested byte for byte) without its per-call image pyramid, keypoint copies and
-/// allocations: the image is blurred as ORB blurs it (the same cv::GaussianBlur call on a
-/// bordered copy), then each descriptor is 256 comparisons at precomputed offsets. Patch size
-/// 31 uses ORB's built-in test pattern, which is not rebuilt here: that size goes to cv::ORB.
+/// allocations: the image is blurred as ORB blurs it (7 x 7, sigma 2 on a view into a bordered
+/// copy: the same bytes, by GaussianBlur8u's View path into a reused image), then each
+/// descriptor is 256 comparisons at precomputed offsets. Patch size 31 uses ORB's built-in test
+/// pattern, which is not rebuilt here: that size goes to cv::ORB.
 class OrbDescriber {
  public:
   /// `patch_size`: ORB patch in pixels (odd). Keypoints closer than the patch size to the image
@@ -48,7 +50,8 @@ class OrbDescriber {
   std::vector<cv::Point> pattern_;  ///< ORB's 512 test points for this patch size (256 pairs)
   std::vector<int> offsets_;        ///< pattern_ as byte offsets for `offsets_step_`
   size_t offsets_step_ = 0;
-  cv::Mat bordered_;  ///< image + reflected border, blurred in place inside the border
+  GaussianBlur8u blur_{7, 2.0, GaussianBlur8u::Path::View};  ///< ORB's blur (of a bordered copy)
+  cv::Mat blurred_;
   std::vector<Keypoint> kept_;
   bool use_opencv_ = false;
   cv::Ptr<cv::ORB> orb_;  ///< created on first use of the OpenCV path
