@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # `odometry` reads a recording at the range bin size its sensor.json states (a RADIATE-model
 # recording has 0.174 m bins, not the Oxford layout's 0.0438 m): the travelled distance matches
-# the truth; --range-resolution still overrides it; a malformed sensor.json is a named error.
+# the truth; --range-resolution still overrides it; a recording's ranges get no dataset range
+# offset (a MulRan-model recording has 3360 bins, the Boreas layout, whose -0.31 m offset it
+# must not get); a malformed sensor.json is a named error.
 # Usage: odometry_recorded_sensor.sh SPINRADAR_BIN OUT_DIR
 set -euo pipefail
 bin="$1"; out="$2"
@@ -10,6 +12,13 @@ rm -rf "$out"; mkdir -p "$out"
 "$bin" odometry --input "$out/drive/radar" --quiet --out "$out/own.csv" 2>"$out/own.log"
 grep -q "range bins of 0.17361 m from .*drive/sensor.json" "$out/own.log" \
   || { echo "FAIL: sensor.json not read"; cat "$out/own.log"; exit 1; }
+grep -q "ranges as recorded (no dataset range offset)" "$out/own.log" \
+  || { echo "FAIL: range offset not stated"; cat "$out/own.log"; exit 1; }
+"$bin" simulate --scene city --sensor mulran --t0 20 --scans 2 --out "$out/mulran" 2>"$out/simulate_mulran.log"
+"$bin" odometry --input "$out/mulran" --quiet --out "$out/mulran.csv" 2>"$out/mulran.log"
+grep -q "boreas scans" "$out/mulran.log" || { echo "FAIL: 3360 bins not read as the Boreas layout"; cat "$out/mulran.log"; exit 1; }
+grep -q "ranges as recorded (no dataset range offset)" "$out/mulran.log" \
+  || { echo "FAIL: the Boreas range offset was applied to a recording"; cat "$out/mulran.log"; exit 1; }
 "$bin" odometry --input "$out/drive" --quiet --range-resolution 0.0438 --out "$out/forced.csv" 2>"$out/forced.log"
 /usr/bin/env python3 - "$out/drive/trajectory.csv" "$out/own.csv" "$out/forced.csv" <<'PY'
 import csv, math, sys
