@@ -18,6 +18,7 @@
 
 #include "cli_checks.hpp"
 #include "command.hpp"
+#include "huge_page_heap.hpp"
 #include "output_guard.hpp"
 #include "pipeline_options.hpp"
 #include "progress.hpp"
@@ -216,6 +217,7 @@ void printStageTotals(const StageTimes& t, double load_ms, double wait_ms, bool 
 
 void run(OdometryArgs& a) {
   namespace fs = std::filesystem;
+  cli::preferHugePageHeap();  // before the scans' buffers and the loader threads
   if (!fs::exists(a.input)) throw std::runtime_error(a.input + ": no such folder");
   if (!fs::is_directory(a.input)) throw std::runtime_error(a.input + ": not a folder");
   const PipelineConfig cfg = a.pipeline.resolve();

@@ -1,6 +1,7 @@
 // The Cartesian image puts a return at (r, phi) at the right pixel; tables are cached.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <thread>
 
@@ -204,6 +205,35 @@ TEST(Cartesian, SimdAndPortableRemapAgree) {
   simd.render(s, a);
   portable.render(s, b);
   EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
+}
+
+TEST(Cartesian, SimdAndPortableTableBuildsAgree) {
+  // Several scan geometries: the default, a range offset, fewer bins than the image's radius
+  // (pixels beyond the last bin take the zero row), a coarse box and uneven azimuths.
+  std::vector<std::pair<PolarScan, double>> cases;
+  cases.push_back({emptyScan(), 0.0});
+  cases.push_back({emptyScan(), -0.31});
+  cases.push_back({emptyScan(400, 900, 0.0438), 0.2});
+  cases.push_back({emptyScan(200, 3000, 0.175), 0.0});
+  PolarScan uneven = emptyScan(400, 3768, 0.0438, 5000);  // wraps past 2 pi mid-sweep
+  for (int a = 0; a < 400; a += 7) uneven.azimuth[a] += 0.3 * 2 * M_PI / 400;
+  cases.push_back({uneven, 0.0});
+  int zero_row_cases = 0;
+  for (const auto& [res, width] : {std::pair{0.2592, 964}, {0.17, 301}}) {
+    for (size_t c = 0; c < cases.size(); ++c) {
+      CartesianTableCache simd(res, width), portable(res, width);
+      portable.setUseSimd(false);
+      bool built = false;
+      const auto a = simd.remapFor(cases[c].first, cases[c].second, built);
+      const auto b = portable.remapFor(cases[c].first, cases[c].second, built);
+      ASSERT_EQ(a->offsets.size(), size_t(width) * width);
+      EXPECT_TRUE(a->offsets == b->offsets) << "case " << c << ", width " << width;
+      EXPECT_TRUE(a->weights == b->weights) << "case " << c << ", width " << width;
+      const uint32_t zero_row = uint32_t(cases[c].first.azimuths + 1) * cases[c].first.bins;
+      zero_row_cases += std::count(a->offsets.begin(), a->offsets.end(), zero_row) > 0;
+    }
+  }
+  EXPECT_GE(zero_row_cases, 3);  // pixels beyond the last bin (or before the first) were covered
 }
 
 TEST(Cartesian, PixelGeometryEqualsHypotAndAtan2PerPixel) {

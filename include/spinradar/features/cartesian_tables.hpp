@@ -52,6 +52,12 @@ class CartesianTableCache {
   /// which). Older tables stay valid for whoever still holds them.
   std::shared_ptr<const CartesianRemap> remapFor(const PolarScan& scan, double offset, bool& built);
   int builds() const;  ///< remap tables built so far, by all users
+  /// Builds the remap tables with AVX2 when the CPU has it (default); off = portable loop. Both
+  /// give identical tables (the switch exists so that tests compare them).
+  void setUseSimd(bool use) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    use_simd_ = use;
+  }
 
  private:
   std::shared_ptr<const CartesianPixelGeometry> pixelsLocked();
@@ -62,6 +68,7 @@ class CartesianTableCache {
   std::shared_ptr<const CartesianPixelGeometry> pixels_;
   std::shared_ptr<const CartesianRemap> remap_;
   int builds_ = 0;
+  bool use_simd_ = true;
 };
 
 }  // namespace spinradar
