@@ -24,6 +24,7 @@
 #include "progress.hpp"
 #include "recording_sensor.hpp"
 #include "spinradar/estimation/odometry.hpp"
+#include "spinradar/features/cartesian_tables.hpp"
 #include "spinradar/features/feature_extractor.hpp"
 #include "spinradar/io/poses_io.hpp"
 #include "spinradar/io/scan_folder.hpp"
@@ -93,6 +94,9 @@ class ScanPrefetcher {
     cpu_ms_.assign(workers_, 0.0);
     threads_.reserve(workers_);
     for (size_t w = 0; w < workers_; ++w) threads_.emplace_back([this, w] { loop(w); });
+    // The pixel geometry (the scan-independent half of the Cartesian tables, ~7 ms) is built
+    // here while a loader reads and detects the first scan, instead of after it.
+    extractors_.back().cartesianTables()->pixels();
   }
   ~ScanPrefetcher() {
     {
