@@ -133,50 +133,38 @@ AppearanceFinding makeFinding(const std::string& effect, const std::string& para
 }
 
 // Level pre-alignment before the Gauss-Newton fit, which moves a level by at most 3 steps per
-// iteration (6 dB noise, 9 dB gain, 12 dB/decade slopes): a recording 25-35 dB brighter than the
-// base model (Boreas-RT's native level) ended on that trust region after 4 iterations. Counts are
-// about 1 dB each, so the floor figures' gap per band, regressed on log range (a + b log10(r /
-// 10 m), band centres), is the noise level and range slope to add, and the bright figures' gap
-// the receiver gain and its slope; up to 3 rounds, each re-simulated, while a gap is larger than
-// one Newton iteration could take (6 dB, 12 dB/decade).
+// iteration (6 dB noise, 9 dB gain): a recording 25-40 dB brighter than the base model
+// (Boreas-RT's native level) ended on that trust region after 4 iterations. Counts are about
+// 1 dB each, so the mean gap of the floor figures is the noise level to add and that of the
+// bright figures the receiver gain, over the bands the fit uses (the 2.5-10 m band is
+// scene-dependent). Only gaps beyond 3 Newton steps (18 dB noise, 27 dB gain) are pre-aligned,
+// in up to 3 rounds, each re-simulated; the fit does the rest.
 template <class Figures>
 void alignLevels(const AppearanceFigures& real, SensorConfig& cur, Figures figuresOf,
                  std::vector<std::string>& notes) {
-  static const double centre[kBands] = {5.0, 15.8, 35.4, 70.7};  // geometric band centres
-  auto regress = [](const std::array<double, kBands>& r, const std::array<double, kBands>& s,
-                    double& a, double& b) {
-    Eigen::Matrix<double, kBands, 2> X;
-    Eigen::Matrix<double, kBands, 1> y;
-    for (int k = 0; k < kBands; ++k) X(k, 0) = 1, X(k, 1) = std::log10(centre[k] / 10), y[k] = r[k] - s[k];
-    const Eigen::Vector2d ab = X.colPivHouseholderQr().solve(y);
-    a = ab[0], b = ab[1];
+  auto gap = [](const std::array<double, kBands>& r, const std::array<double, kBands>& s) {
+    double g = 0;
+    int n = 0;
+    for (int k = 0; k < kBands; ++k)
+      if (!isSceneDependent(k, "mean")) g += r[k] - s[k], ++n;
+    return n ? g / n : 0.0;
   };
   const SensorConfig start = cur;
   for (int round = 0; round < 3; ++round) {
     const AppearanceFigures f = figuresOf(cur);
-    double na, nb, ga, gb;
-    regress(real.floor, f.floor, na, nb);
-    regress(real.bright, f.bright, ga, gb);
-    const bool noise = std::abs(na) > 6 || std::abs(nb) > 12, gain = std::abs(ga) > 6 || std::abs(gb) > 12;
-    if (!noise && !gain) break;
-    if (noise) {
-      cur.noise_floor_db = std::clamp(cur.noise_floor_db + na, 0.0, 100.0);
-      cur.noise_range_slope_db_per_decade =
-          std::clamp(cur.noise_range_slope_db_per_decade + nb, -40.0, 40.0);
-    }
-    if (gain) {
-      cur.radar_constant_db = std::clamp(cur.radar_constant_db + ga, 0.0, 300.0);
-      cur.range_gain_db_per_decade = std::clamp(cur.range_gain_db_per_decade + gb, 0.0, 60.0);
-    }
+    const double noise = gap(real.floor, f.floor), gain = gap(real.bright, f.bright);
+    const bool move_noise = std::abs(noise) > 18 || (round > 0 && std::abs(noise) > 6);
+    const bool move_gain = std::abs(gain) > 27 || (round > 0 && std::abs(gain) > 9);
+    if (!move_noise && !move_gain) break;
+    if (move_noise) cur.noise_floor_db = std::clamp(cur.noise_floor_db + noise, 0.0, 100.0);
+    if (move_gain) cur.radar_constant_db = std::clamp(cur.radar_constant_db + gain, 0.0, 300.0);
   }
   if (cur.noise_floor_db != start.noise_floor_db || cur.radar_constant_db != start.radar_constant_db) {
     std::ostringstream os;
-    os << std::setprecision(3) << "Level pre-alignment (gaps beyond one Newton step): noise floor "
-       << start.noise_floor_db << " -> " << cur.noise_floor_db << " dB, noise slope "
-       << start.noise_range_slope_db_per_decade << " -> " << cur.noise_range_slope_db_per_decade
-       << " dB/decade, receiver gain " << start.radar_constant_db << " -> "
-       << cur.radar_constant_db << " dB, range gain " << start.range_gain_db_per_decade << " -> "
-       << cur.range_gain_db_per_decade << " dB/decade; the catalogue fit starts from there.";
+    os << std::setprecision(3) << "Level pre-alignment (gaps beyond 3 Newton steps): noise floor "
+       << start.noise_floor_db << " -> " << cur.noise_floor_db << " dB, receiver gain "
+       << start.radar_constant_db << " -> " << cur.radar_constant_db
+       << " dB; the catalogue fit starts from there.";
     notes.push_back(os.str());
   }
 }
@@ -252,7 +240,12 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
   AppearanceFigures fig_cur = moved ? figuresOf(cur, phys) : rep.before;
   Eigen::VectorXd e_cur = detail::figureVector(fig_cur);
   const Eigen::VectorXd e_real = detail::figureVector(rep.real);
-  const Eigen::VectorXd se = detail::differenceSe(rep.real, fig_cur);
+  Eigen::VectorXd se = detail::differenceSe(rep.real, fig_cur);
+  // Scene-dependent figures weigh (almost) nothing: the near band's mean, bright level and
+  // CA-CFAR cells show the street's walls (sceneDependentFigures). Its floor, the lower half of
+  // the counts, is the receiver's noise and stays.
+  for (int k = 0; k < kBands; ++k)
+    if (isSceneDependent(k, "mean")) se[4 + k] = se[8 + k] = se[12 + k] = 1e6;
   const int P = int(active.size());
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(detail::kFigures, P);
   // Blocks: parameters sharing a block number are solved together on their figures.
@@ -310,6 +303,7 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
     return ((e_real - e).array() / se.array()).square().sum();
   };
   // A step cut by the trust region earns one more iteration (up to twice opt.iterations).
+  auto newton = [&]() {
   int iterations = opt.iterations;
   for (int it = 0; it < iterations; ++it) {
     if (it > 0 && opt.relinearise) linearise();
@@ -341,6 +335,81 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
     e_cur = detail::figureVector(fig_cur);
     if (step.cwiseAbs().maxCoeff() < 1e-3) break;
   }
+  };
+  newton();
+  rep.after = fig_cur;
+
+  // --- Multipath ghosts: bright returns behind the first strong hit of a row.
+  {
+    // Against the model fitted so far (clutter also fills the space behind walls).
+    const double d = rep.real.behind - rep.after.behind;
+    const double se_g = std::hypot(rep.real.behind_se, rep.after.behind_se);
+    const double z = se_g > 0 ? d / se_g : 0;
+    const double ratio = rep.real.behind / std::max(rep.after.behind, 1e-6);
+    AppearanceFinding f;
+    f.effect = "multipath ghosts", f.parameter = "multipath", f.unit = "dB";
+    f.base = physicsHasGhosts(physics) ? phys.extra["multipath"].is_number()
+                                             ? phys.extra["multipath"].get<double>()
+                                             : -15.0
+                                       : -INFINITY;
+    f.gap_before = d;
+    f.z = z;
+    f.size = ratio, f.size_unit = "x behind-hit share";
+    f.named = !physicsHasGhosts(physics) && z >= opt.z_min && ratio >= opt.ghost_ratio_min;
+    f.verdict = f.named ? "mismatch" : (z >= opt.z_min ? "negligible" : "not significant");
+    if (f.named) {
+      // Ghost level by interpolating the behind share of re-simulations with ghosts at levels
+      // 5 dB apart (the share grows faster than linearly with the level: a coarser grid biases
+      // the interpolated level low).
+      constexpr int kLevels = 5;
+      const double levels[kLevels] = {-25.0, -20.0, -15.0, -10.0, -5.0};
+      double share[kLevels];
+      auto grid = [&]() {
+        for (int i = 0; i < kLevels; ++i) {
+          sim::PhysicsConfig p = phys;
+          p.extra["multipath"] = levels[i];
+          share[i] = figuresOf(cur, p).behind;
+          if (i > 0) share[i] = std::max(share[i], share[i - 1]);  // monotone in the level
+        }
+      };
+      grid();
+      auto level = [&](double s) {
+        int i = 0;
+        while (i + 2 < kLevels && s > share[i + 1]) ++i;
+        return levels[i] + (s - share[i]) / std::max(share[i + 1] - share[i], 1e-9) * 5;
+      };
+      if (rep.real.behind > share[kLevels - 1] + 2 * rep.real.behind_se) {
+        // More than the strongest ghosts give: not multipath-like (returns through or past the
+        // first reflector, elevation-beam returns); left to the notes, not switched on.
+        f.named = false;
+        f.verdict = "not ghost-like";
+        f.value = NAN;
+        rep.notes.push_back(
+            "Behind the first strong hit the recording has " + std::to_string(100 * rep.real.behind) +
+            " % bright cells, more than multipath ghosts even at -5 dB give (" +
+            std::to_string(100 * share[kLevels - 1]) + " %): penetration or elevation-beam returns the "
+            "simulator's occlusion removes (occlusion_tolerance), not ghosts.");
+      } else {
+        f.value = std::clamp(level(rep.real.behind), -80.0, 0.0);
+        f.stddev = std::abs(level(rep.real.behind + rep.real.behind_se) - f.value);
+        phys.extra["multipath"] = f.value;
+        // The ghosts also brightened the bright figures the receiver gain was fitted to: refit
+        // the smooth parameters with the ghosts on, then the level against that model (one
+        // alternation of the joint fit).
+        fig_cur = figuresOf(cur, phys);
+        e_cur = detail::figureVector(fig_cur);
+        newton();
+        grid();
+        f.value = std::clamp(level(rep.real.behind), -80.0, 0.0);
+        f.stddev = std::abs(level(rep.real.behind + rep.real.behind_se) - f.value);
+        phys.extra["multipath"] = f.value;
+        fig_cur = figuresOf(cur, phys);
+        e_cur = detail::figureVector(fig_cur);
+      }
+    }
+    rep.findings.push_back(f);
+  }
+
   // Uncertainty of the fit: the block covariances, with the residual misfit of each block.
   solveBlocks(e_real - e_cur, true);
   rep.after = fig_cur;
@@ -380,63 +449,6 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
     (J.col(j).array() / se.array()).abs().maxCoeff(&fi);
     f.gap_before = e_real[fi] - e_before[fi];
     f.gap_after = e_real[fi] - e_cur[fi];
-    rep.findings.push_back(f);
-  }
-
-  // --- Multipath ghosts: bright returns behind the first strong hit of a row.
-  {
-    // Against the model fitted so far (clutter also fills the space behind walls).
-    const double d = rep.real.behind - rep.after.behind;
-    const double se_g = std::hypot(rep.real.behind_se, rep.after.behind_se);
-    const double z = se_g > 0 ? d / se_g : 0;
-    const double ratio = rep.real.behind / std::max(rep.after.behind, 1e-6);
-    AppearanceFinding f;
-    f.effect = "multipath ghosts", f.parameter = "multipath", f.unit = "dB";
-    f.base = physicsHasGhosts(physics) ? phys.extra["multipath"].is_number()
-                                             ? phys.extra["multipath"].get<double>()
-                                             : -15.0
-                                       : -INFINITY;
-    f.gap_before = d;
-    f.z = z;
-    f.size = ratio, f.size_unit = "x behind-hit share";
-    f.named = !physicsHasGhosts(physics) && z >= opt.z_min && ratio >= opt.ghost_ratio_min;
-    f.verdict = f.named ? "mismatch" : (z >= opt.z_min ? "negligible" : "not significant");
-    if (f.named) {
-      // Ghost level by interpolating the behind share of re-simulations with ghosts at levels
-      // 5 dB apart (the share grows faster than linearly with the level: a coarser grid biases
-      // the interpolated level low).
-      constexpr int kLevels = 5;
-      const double levels[kLevels] = {-25.0, -20.0, -15.0, -10.0, -5.0};
-      double share[kLevels];
-      for (int i = 0; i < kLevels; ++i) {
-        sim::PhysicsConfig p = phys;
-        p.extra["multipath"] = levels[i];
-        share[i] = figuresOf(cur, p).behind;
-        if (i > 0) share[i] = std::max(share[i], share[i - 1]);  // monotone in the level
-      }
-      auto level = [&](double s) {
-        int i = 0;
-        while (i + 2 < kLevels && s > share[i + 1]) ++i;
-        return levels[i] + (s - share[i]) / std::max(share[i + 1] - share[i], 1e-9) * 5;
-      };
-      if (rep.real.behind > share[kLevels - 1] + 2 * rep.real.behind_se) {
-        // More than the strongest ghosts give: not multipath-like (returns through or past the
-        // first reflector, elevation-beam returns); left to the notes, not switched on.
-        f.named = false;
-        f.verdict = "not ghost-like";
-        f.value = NAN;
-        rep.notes.push_back(
-            "Behind the first strong hit the recording has " + std::to_string(100 * rep.real.behind) +
-            " % bright cells, more than multipath ghosts even at -5 dB give (" +
-            std::to_string(100 * share[kLevels - 1]) + " %): penetration or elevation-beam returns the "
-            "simulator's occlusion removes (occlusion_tolerance), not ghosts.");
-      } else {
-        f.value = std::clamp(level(rep.real.behind), -80.0, 0.0);
-        f.stddev = std::abs(level(rep.real.behind + rep.real.behind_se) - f.value);
-        phys.extra["multipath"] = f.value;
-        rep.after = figuresOf(cur, phys);
-      }
-    }
     rep.findings.push_back(f);
   }
 

@@ -1,4 +1,5 @@
 // Appearance stage: locate the differences, realism before/after, report files and plots.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -198,7 +199,8 @@ std::string AppearanceReport::summaryMarkdown() const {
     };
     over(realism_real, "fit part");
     if (!realism_holdout.name.empty()) over(realism_holdout, "held-out part");
-    os << "\n\n**Scene-dependent, not fitted** (real fit part / held out / sim before / after):\n";
+    os << "\n\n**Scene-dependent, not fitted** (real fit part / held out / sim before / after; "
+          "why below):\n";
     const char* const band_names[kBands] = {"2.5-10 m", "10-25 m", "25-50 m", "50-100 m"};
     auto value = [](const sim::RealismStats& s, int k, const std::string& f) {
       return f == "mean" ? s.band_mean[k] : f == "q90" ? s.band_q90[k]
@@ -210,8 +212,13 @@ std::string AppearanceReport::summaryMarkdown() const {
          << (realism_holdout.name.empty() ? std::string("-")
                                           : fmt(value(realism_holdout, f.band, f.figure), 4))
          << " / " << fmt(value(realism_before, f.band, f.figure), 4) << " / "
-         << fmt(value(realism_after, f.band, f.figure), 4) << ". " << f.reason << ".";
+         << fmt(value(realism_after, f.band, f.figure), 4);
     }
+    std::vector<std::string> reasons;  // once each
+    for (const auto& f : sceneDependentFigures())
+      if (std::find(reasons.begin(), reasons.end(), f.reason) == reasons.end())
+        reasons.push_back(f.reason);
+    for (const auto& r : reasons) os << "\n\nWhy: " << r << ".";
     os << "\n";
   }
   return os.str();

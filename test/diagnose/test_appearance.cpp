@@ -89,7 +89,7 @@ INSTANTIATE_TEST_SUITE_P(
              [](sim::SensorConfig& s, sim::PhysicsConfig&, double) { s.noise_floor_db += 25; }},
         Case{"saturation", "saturation", 0, 1.0,
              [](sim::SensorConfig& s, sim::PhysicsConfig&, double top) { s.saturation = top - 20; }},
-        Case{"ghosts", "multipath", -15.0, 1.5,
+        Case{"ghosts", "multipath", -15.0, 1.0,
              [](sim::SensorConfig&, sim::PhysicsConfig& p, double) { p.extra["multipath"] = -15.0; }}),
     [](const ::testing::TestParamInfo<Case>& i) { return std::string(i.param.name); });
 

@@ -86,7 +86,7 @@ struct AppearanceOptions {
   bool realism = true;         ///< realism tables before/after (with detectors)
   /// Per-band calibration after the global fit: range curves fitted on the per-band realism
   /// figures (fitRangeCurves); 0 iterations = off.
-  int curve_iterations = 16;
+  int curve_iterations = 24;
   /// Fit on part of the recording and check on the rest (splitHoldout).
   bool holdout = true;
 };
