@@ -34,12 +34,18 @@ class GaussianBlur8u {
   /// memory with `src`.
   void apply(const cv::Mat& src, cv::Mat& dst);
 
+  /// View path: 2 = AVX-512 when the CPU has it, else AVX2 + FMA (default); 1 = AVX2 + FMA at
+  /// most; 0 = portable (OpenCV's non-AVX2 build: multiply, then add). Levels 2 and 1 give the
+  /// same bytes (tested); the switch exists so that tests cover each.
+  void setSimdLevel(int level) { simd_ = level; }
+
   /// The fixed-point path's taps in 1/256 (the View path uses the float kernel).
   const std::vector<uint32_t>& taps() const { return taps_; }
 
  private:
   int ksize_, radius_;
   Path path_;
+  int simd_ = 2;
   std::vector<uint32_t> taps_;
   std::vector<float> float_taps_;
   std::vector<uint8_t> padded_;  ///< one source row with reflected ends
