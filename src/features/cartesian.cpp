@@ -67,6 +67,36 @@ __attribute__((target("avx2"))) void remapAvx2(const uint8_t* pol, int bins, con
   }
 }
 
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's AVX-512 headers
+bool cpuHasAvx512() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw");
+}
+/// As remapAvx2, 16 pixels at a time.
+__attribute__((target("avx512f,avx512bw"))) void remapAvx512(const uint8_t* pol, int bins, const uint32_t* off,
+                                                              const uint8_t* wt, uint8_t* out, int count) {
+  const __m512i lowbyte = _mm512_set1_epi32(0xff), half = _mm512_set1_epi32(128);
+  const int* base_a = reinterpret_cast<const int*>(pol);
+  const int* base_b = reinterpret_cast<const int*>(pol + bins);
+  int i = 0;
+  for (; i + 16 <= count; i += 16) {
+    const __m512i o = _mm512_loadu_si512(off + i);
+    const __m512i a = _mm512_and_si512(_mm512_i32gather_epi32(o, base_a, 1), lowbyte);
+    const __m512i b = _mm512_and_si512(_mm512_i32gather_epi32(o, base_b, 1), lowbyte);
+    const __m512i w = _mm512_cvtepu8_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(wt + i)));
+    const __m512i r =
+        _mm512_add_epi32(a, _mm512_srai_epi32(_mm512_add_epi32(_mm512_mullo_epi32(_mm512_sub_epi32(b, a), w), half), 8));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i), _mm512_cvtusepi32_epi8(_mm512_max_epi32(r, _mm512_setzero_si512())));
+  }
+  for (; i < count; ++i) {
+    const uint8_t* p = pol + off[i];
+    const int a = p[0], b = p[bins];
+    out[i] = static_cast<uint8_t>(a + (((b - a) * wt[i] + 128) >> 8));
+  }
+}
+#pragma GCC diagnostic pop
+
 /// Centred box sums of `k` bins for bins [j, j1], 16 at a time, in the same 16-bit fixed point
 /// as the SSE loop below (identical bytes). Returns the first bin not done.
 __attribute__((target("avx2"))) int boxRowAvx2(const uint8_t* row, uint8_t* dst, int j, int j1, int left, int k,
@@ -93,7 +123,13 @@ void CartesianProjector::remapRows(uint8_t* image, size_t image_step) const {
   const uint8_t* wt = remap_->weights.data();
 #if defined(__GNUC__) && defined(__x86_64__)
   static const bool avx2 = cpuHasAvx2();
-  if (avx2 && use_simd_) {
+  static const bool avx512 = avx2 && cpuHasAvx512();
+  if (avx512 && simd_ >= 2) {
+    for (int v = 0; v < width_; ++v)
+      remapAvx512(pol, bins, off + size_t(v) * width_, wt + size_t(v) * width_, image + v * image_step, width_);
+    return;
+  }
+  if (avx2 && simd_ >= 1) {
     for (int v = 0; v < width_; ++v)
       remapAvx2(pol, bins, off + size_t(v) * width_, wt + size_t(v) * width_, image + v * image_step, width_);
     return;
@@ -151,7 +187,7 @@ void CartesianProjector::render(const PolarScan& scan, cv::Mat& image, double ex
     int j = j0;
 #if defined(__GNUC__) && defined(__x86_64__)
     static const bool avx2 = cpuHasAvx2();
-    if (avx2 && use_simd_) j = boxRowAvx2(row, dst, j, j1, left, k, static_cast<uint16_t>((65536 + k - 1) / k));
+    if (avx2 && simd_ >= 1) j = boxRowAvx2(row, dst, j, j1, left, k, static_cast<uint16_t>((65536 + k - 1) / k));
 #endif
 #if defined(__SSE4_1__)
     const __m128i inv16 = _mm_set1_epi16(static_cast<short>((65536 + k - 1) / k)), rnd = _mm_set1_epi16(short(k / 2));

@@ -52,9 +52,11 @@ class CartesianProjector {
     return {(centre_ - px.y) * resolution_, (centre_ - px.x) * resolution_};
   }
 
-  /// Lets the remap use AVX2 gathers when the CPU has them (default). Off = portable loop;
-  /// both give identical images (the switch exists so tests cover both paths).
-  void setUseSimd(bool use) { use_simd_ = use; }
+  /// Lets the remap use AVX-512 or AVX2 gathers when the CPU has them (default). Off = portable
+  /// loop; all give identical images (the switch exists so tests cover every path).
+  void setUseSimd(bool use) { simd_ = use ? 2 : 0; }
+  /// 2 = AVX-512 when the CPU has it, else AVX2 (default); 1 = AVX2 at most; 0 = portable.
+  void setSimdLevel(int level) { simd_ = level; }
 
   double resolution() const { return resolution_; }
   int width() const { return width_; }
@@ -77,7 +79,7 @@ class CartesianProjector {
   int width_ = 964;
   double centre_ = 481.5;
   int builds_ = 0;
-  bool use_simd_ = true;
+  int simd_ = 2;
   std::shared_ptr<CartesianTableCache> cache_;
   std::shared_ptr<const CartesianRemap> remap_;  ///< tables of the current scan geometry
   Table<uint8_t> polar_;  ///< (azimuths + 3) x bins: smoothed rows, row 0 again (wrap), 2 zero rows
