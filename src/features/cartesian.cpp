@@ -67,8 +67,10 @@ __attribute__((target("avx2"))) void remapAvx2(const uint8_t* pol, int bins, con
   }
 }
 
+#if !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's AVX-512 headers
+#endif
 bool cpuHasAvx512() {
   __builtin_cpu_init();
   return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw");
@@ -95,7 +97,9 @@ __attribute__((target("avx512f,avx512bw"))) void remapAvx512(const uint8_t* pol,
     out[i] = static_cast<uint8_t>(a + (((b - a) * wt[i] + 128) >> 8));
   }
 }
+#if !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 /// Centred box sums of `k` bins for bins [j, j1], 16 at a time, in the same 16-bit fixed point
 /// as the SSE loop below (identical bytes). Returns the first bin not done.

@@ -193,8 +193,10 @@ __attribute__((target("avx2,fma"))) void floatColumnAvx2T(const float* const* r,
   for (int j = 0; j < k; ++j) rest[j] = r[j] + x;
   floatColumnBody<true>(rest, t, k, out + x, width - x);
 }
+#if !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's AVX-512 headers
+#endif
 /// And 16 at a time with AVX-512 (same operations per lane).
 bool cpuHasAvx512() {
   __builtin_cpu_init();
@@ -231,7 +233,9 @@ __attribute__((target("avx512f"))) void floatColumnAvx512T(const float* const* r
   for (int j = 0; j < k; ++j) rest[j] = r[j] + x;
   floatColumnBody<true>(rest, t, k, out + x, width - x);
 }
+#if !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 void floatRowAvx512(const float* pad, const float* t, int k, float* out, int width) {
   (k == 7 ? floatRowAvx512T<7> : floatRowAvx512T<0>)(pad, t, k, out, width);
 }
@@ -280,9 +284,12 @@ void GaussianBlur8u::apply(const cv::Mat& src, cv::Mat& dst) {
   const bool whole = path_ == Path::WholeImage;
   padded_.resize(size_t(W) + 2 * r);
   if (!whole) padded_float_.resize(padded_.size());
-  ring_.resize(size_t(k) * W);  // 32-bit words: integer or float row sums
+  if (whole)
+    ring_.resize(size_t(k) * W);
+  else
+    float_ring_.resize(size_t(k) * W);
   uint32_t* ring = ring_.data();
-  float* fring = reinterpret_cast<float*>(ring);
+  float* fring = float_ring_.data();
   // Row sums of source row y go to ring slot y % k. Output row y reads the rows y - r .. y + r,
   // reflected into [0, H): a window of at most k consecutive rows, so distinct slots.
   auto rowSumsOf = [&](int y) {

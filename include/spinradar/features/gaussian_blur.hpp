@@ -50,7 +50,8 @@ class GaussianBlur8u {
   std::vector<float> float_taps_;
   std::vector<uint8_t> padded_;  ///< one source row with reflected ends
   std::vector<float> padded_float_;  ///< the same as floats (View)
-  std::vector<uint32_t> ring_;   ///< row sums (integer or float) of ksize rows, slot = row % ksize
+  std::vector<uint32_t> ring_;   ///< row sums of ksize rows, slot = row % ksize (WholeImage)
+  std::vector<float> float_ring_;  ///< the same in float (View)
 };
 
 }  // namespace spinradar
