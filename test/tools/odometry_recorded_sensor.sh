@@ -37,7 +37,9 @@ print(f"travelled: truth {true:.3f} m, own bins {own:.3f} m, forced 0.0438 m bin
 if true < 1.0: sys.exit("FAIL: the drive did not move")
 # Within 20 % (six scans from standstill); a wrong bin size is off by a factor of four.
 if abs(own - true) > 0.2 * true: sys.exit("FAIL: not read at the recording's bin size")
-if abs(forced / own - 0.0438 / 0.17361) > 0.05 * 0.0438 / 0.17361:
+# Within 15 %: the two runs see the scene at different scales and drift differently (7.6 % apart
+# with the 2026-11 RADIATE calibration); not overriding would give a ratio of 1, four times this.
+if abs(forced / own - 0.0438 / 0.17361) > 0.15 * 0.0438 / 0.17361:
     sys.exit("FAIL: --range-resolution did not override sensor.json")
 PY
 echo '{"range_resolution": "wide"}' > "$out/drive/sensor.json"
