@@ -315,8 +315,10 @@ void GaussianBlur8u::apply(const cv::Mat& src, cv::Mat& dst) {
     for (; done < std::min(H, y + r + 1); ++done) rowSumsOf(done);
     for (int j = 0; j < k; ++j) {
       const size_t slot = size_t(cv::borderInterpolate(y - r + j, H, cv::BORDER_REFLECT_101) % k) * W;
-      taps_rows[j] = ring + slot;
-      ftaps_rows[j] = fring + slot;
+      if (whole)  // (only the ring in use has storage)
+        taps_rows[j] = ring + slot;
+      else
+        ftaps_rows[j] = fring + slot;
     }
     if (whole)
       columns(taps_rows, taps_.data(), k, dst.ptr<uint8_t>(y), W);
