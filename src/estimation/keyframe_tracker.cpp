@@ -21,6 +21,21 @@ double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
 KeyframeTracker::KeyframeTracker(const EstimatorConfig& config) : config_(config) {}
 
+double KeyframeTracker::rowQuantization(const FeatureFrame& f) {
+  int same_row = 0, same_angle = 0;
+  double step = 0.0;
+  const std::vector<Keypoint>& k = f.keypoints;
+  for (size_t i = 1; i < k.size(); ++i) {
+    if (k[i].azimuth_index == k[i - 1].azimuth_index) {
+      ++same_row;
+      same_angle += k[i].azimuth == k[i - 1].azimuth;
+    } else if (step == 0.0 && k[i].azimuth_index == k[i - 1].azimuth_index + 1) {
+      step = std::abs(wrapAngle(k[i].azimuth - k[i - 1].azimuth));
+    }
+  }
+  return same_row >= 20 && same_angle >= 0.9 * same_row ? step : 0.0;
+}
+
 void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d& xi, double c,
                                    const Eigen::Matrix3d& T_w, const Eigen::Matrix3d& P) {
   // The keyframe's points as a static map: Doppler-corrected and moved to its reference
@@ -204,6 +219,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   last_stamp_ = cur.stamp_ns;
   has_last_stamp_ = true;
   const double c = kMidScan * dt;  // this scan's reference: mid-scan
+  row_step_ = rowQuantization(cur);
   if (!has_key_) {
     se2::compoundXyYaw(T_w_prev, P_prev, pair.T_12, pair.T_12_cov, T_w, P);
     rel_key_stamp_ = cur.stamp_ns;
@@ -311,6 +327,13 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     // back with is off by between 0 and the step (uniform: second moment dw^2 / 3). Without this the turn exits held NEES of 100-800 (1-1.8 deg errors
     // against 0.06-0.15 deg sigmas).
     Cd(5, 5) += dw2 / 3.0;
+    // Row keypoints: a target moves by a fractional number of rows between the keyframe and
+    // this scan and every match rounds it the same way, so the registration's yaw has an
+    // error common to all its points, about uniform over a row (variance step^2 / 12), which
+    // averaging over points does not shrink. Measured on the city route (400 scans, keyframe
+    // switches on straights): yaw error rms 0.26 deg = 0.9 deg / sqrt(12) with row keypoints,
+    // 0.09 deg with azimuth peaks; the accumulated-pose NEES was 9.99 without this term.
+    if (registered) Cd(2, 2) += row_step_ * row_step_ / 12.0;
     Eigen::Matrix<double, 3, 6> J;
     J.leftCols<3>() = se2::adjoint(E_j);
     J.rightCols<3>() = -c * se2::adjoint(T_rel);

@@ -83,6 +83,11 @@ class KeyframeTracker {
     return Eigen::Vector3d(ql * ql, ql * ql, qa * qa);
   }
 
+  /// The row spacing (rad) when f's keypoints are row keypoints (every keypoint of a row at
+  /// the row's angle, as the detector gives them without azimuth_peaks), else 0: at least 20
+  /// pairs of keypoints share a row and 90 % of those share its angle exactly.
+  static double rowQuantization(const FeatureFrame& f);
+
   int lastInliers() const { return last_inliers_; }
   /// The last tracked scan's pose relative to its keyframe (the scan at keyframeStamp(); the
   /// keyframe in use when the scan was registered, even if the scan then became the next
@@ -163,6 +168,7 @@ class KeyframeTracker {
   void associateByProximity(const FeatureFrame& cur, const Eigen::Matrix3d& T_pred,
                             const Eigen::Vector3d& xi, double c);
   void addMatch(const Eigen::Vector2d& key_pt, const Keypoint& k, double tau);
+  double row_step_ = 0.0;  ///< rowQuantization() of the scan being tracked
 };
 
 }  // namespace spinradar
