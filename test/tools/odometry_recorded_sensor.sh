@@ -14,11 +14,16 @@ grep -q "range bins of 0.17361 m from .*drive/sensor.json" "$out/own.log" \
   || { echo "FAIL: sensor.json not read"; cat "$out/own.log"; exit 1; }
 grep -q "ranges as recorded (no dataset range offset)" "$out/own.log" \
   || { echo "FAIL: range offset not stated"; cat "$out/own.log"; exit 1; }
-"$bin" simulate --scene city --sensor mulran --t0 20 --scans 2 --out "$out/mulran" 2>"$out/simulate_mulran.log"
+"$bin" simulate --scene city --sensor mulran --t0 20 --scans 4 --out "$out/mulran" 2>"$out/simulate_mulran.log"
 "$bin" odometry --input "$out/mulran" --quiet --out "$out/mulran.csv" 2>"$out/mulran.log"
 grep -q "boreas scans" "$out/mulran.log" || { echo "FAIL: 3360 bins not read as the Boreas layout"; cat "$out/mulran.log"; exit 1; }
 grep -q "ranges as recorded (no dataset range offset)" "$out/mulran.log" \
   || { echo "FAIL: the Boreas range offset was applied to a recording"; cat "$out/mulran.log"; exit 1; }
+# Same poses as when read as the Oxford layout (exact ranges, no offset) at the same bin size.
+"$bin" odometry --input "$out/mulran" --quiet --format oxford --range-resolution 0.0595238 \
+  --out "$out/mulran_oxford.csv" 2>"$out/mulran_oxford.log"
+cmp -s "$out/mulran.csv" "$out/mulran_oxford.csv" \
+  || { echo "FAIL: the recording's ranges differ from the exact ones"; diff "$out/mulran.csv" "$out/mulran_oxford.csv" | head; exit 1; }
 "$bin" odometry --input "$out/drive" --quiet --range-resolution 0.0438 --out "$out/forced.csv" 2>"$out/forced.log"
 /usr/bin/env python3 - "$out/drive/trajectory.csv" "$out/own.csv" "$out/forced.csv" <<'PY'
 import csv, math, sys
