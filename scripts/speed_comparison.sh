@@ -6,8 +6,8 @@
 #   - two threads (scans decoded in the background): scans per second
 #   - peak resident memory (/usr/bin/time -v)
 # CFEAR and the paper's code run side by side on the same folder when their commands are given
-# (they cannot be built here); otherwise the issue's figures, measured elsewhere, are printed and
-# labelled so. Each figure is the best of REPEAT runs (the machine may be shared), with the median.
+# (neither is part of this repository: build them from their public code, README "Speed");
+# otherwise the issue's figures, measured elsewhere, are printed and labelled so. Each figure is the best of REPEAT runs (the machine may be shared), with the median.
 # Usage: scripts/speed_comparison.sh [WORK_DIR]   (default build/speed_comparison)
 # Env: SPINRADAR_BIN, SCANS (40), REPEAT (5), CORE (0: the core for the one-thread run),
 #      CFEAR_CMD / PAPER_CMD: command lines with {radar} (folder of PNGs) and {out} (a folder for
@@ -88,8 +88,8 @@ if [[ -n "${CFEAR_CMD:-}" ]]; then side_by_side cfear "$CFEAR_CMD"; any=1; fi
 if [[ -n "${PAPER_CMD:-}" ]]; then side_by_side paper "$PAPER_CMD"; any=1; fi
 if [[ $any == 0 ]]; then
   cat <<'EOF'
-Not run here (no CFEAR_CMD/CFEAR_BIN, PAPER_CMD/PAPER_BIN given; they cannot be built on this
-machine). MEASURED ELSEWHERE (issue 21, same 40-scan drive, side by side, one core):
+Not run here (no CFEAR_CMD/CFEAR_BIN, PAPER_CMD/PAPER_BIN given; see README "Speed" for how
+they were built). MEASURED ELSEWHERE (issue 21, same 40-scan drive, side by side, one core):
   paper's code (Burnett et al.)        123-127 ms per scan
   CFEAR-1                              28.5 ms per scan (19 ms over 400 scans)
   CFEAR-2                              21 ms per scan over 400 scans
