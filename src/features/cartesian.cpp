@@ -1,4 +1,5 @@
 #include "spinradar/features/cartesian.hpp"
+#include "cpu_support.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -38,10 +39,6 @@ void CartesianProjector::setImageGeometry(double resolution, int width) {
 
 namespace {
 #if defined(__GNUC__) && defined(__x86_64__)
-bool cpuHasAvx2() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2");
-}
 
 /// Eight pixels at a time with gathers; `pol` must be readable 3 bytes past its last row.
 __attribute__((target("avx2"))) void remapAvx2(const uint8_t* pol, int bins, const uint32_t* off, const uint8_t* wt,
@@ -71,10 +68,6 @@ __attribute__((target("avx2"))) void remapAvx2(const uint8_t* pol, int bins, con
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's AVX-512 headers
 #endif
-bool cpuHasAvx512() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw");
-}
 /// As remapAvx2, 16 pixels at a time.
 __attribute__((target("avx512f,avx512bw"))) void remapAvx512(const uint8_t* pol, int bins, const uint32_t* off,
                                                               const uint8_t* wt, uint8_t* out, int count) {
@@ -126,8 +119,8 @@ void CartesianProjector::remapRows(uint8_t* image, size_t image_step) const {
   const uint32_t* off = remap_->offsets.data();
   const uint8_t* wt = remap_->weights.data();
 #if defined(__GNUC__) && defined(__x86_64__)
-  static const bool avx2 = cpuHasAvx2();
-  static const bool avx512 = avx2 && cpuHasAvx512();
+  static const bool avx2 = cpu::hasAvx2();
+  static const bool avx512 = avx2 && cpu::hasAvx512bw();
   if (avx512 && simd_ >= 2) {
     for (int v = 0; v < width_; ++v)
       remapAvx512(pol, bins, off + size_t(v) * width_, wt + size_t(v) * width_, image + v * image_step, width_);
@@ -190,7 +183,7 @@ void CartesianProjector::render(const PolarScan& scan, cv::Mat& image, double ex
     const int j0 = left, j1 = bins - (k - left);  // [j0, j1] have full windows
     int j = j0;
 #if defined(__GNUC__) && defined(__x86_64__)
-    static const bool avx2 = cpuHasAvx2();
+    static const bool avx2 = cpu::hasAvx2();
     if (avx2 && simd_ >= 1) j = boxRowAvx2(row, dst, j, j1, left, k, static_cast<uint16_t>((65536 + k - 1) / k));
 #endif
 #if defined(__SSE4_1__)

@@ -1,4 +1,5 @@
 #include "spinradar/features/cartesian_tables.hpp"
+#include "cpu_support.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -82,10 +83,6 @@ std::shared_ptr<CartesianPixelGeometry> buildPixelGeometry(double resolution, in
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
-bool cpuHasAvx2() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2");
-}
 
 /// The per-pixel loop of buildRemap, 8 pixels at a time with the same float operations (multiply
 /// then add, round half away from zero, the same tests): identical tables (tested). Returns the
@@ -175,7 +172,7 @@ std::shared_ptr<CartesianRemap> buildRemap(const CartesianPixelGeometry& g, cons
   const float b0 = static_cast<float>(-offset / scan.range_resolution - 0.5);
   size_t i = 0;
 #if defined(__GNUC__) && defined(__x86_64__)
-  static const bool avx2 = cpuHasAvx2();
+  static const bool avx2 = cpu::hasAvx2();
   if (avx2 && use_simd)
     i = remapPixelsAvx2(g.range.data(), g.angle.data(), angle_row.data(), pixels, inv_res, b0, scan.bins,
                         static_cast<uint32_t>(bins), zero_row, t->offsets.data(), t->weights.data());

@@ -1,4 +1,5 @@
 #include "spinradar/features/gaussian_blur.hpp"
+#include "cpu_support.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -134,10 +135,6 @@ void floatColumn(const float* const* r, const float* t, int k, uint8_t* out, int
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
-bool cpuHasAvx2() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-}
 __attribute__((target("avx2,fma"))) void rowSumsAvx2(const uint8_t* pad, const uint32_t* t, int k, uint32_t* out,
                                                      int width) {
   rowSumsBody(pad, t, k, out, width);
@@ -198,10 +195,6 @@ __attribute__((target("avx2,fma"))) void floatColumnAvx2T(const float* const* r,
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's AVX-512 headers
 #endif
 /// And 16 at a time with AVX-512 (same operations per lane).
-bool cpuHasAvx512() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx512f");
-}
 template <int K>
 __attribute__((target("avx512f"))) void floatRowAvx512T(const float* pad, const float* t, int k, float* out,
                                                         int width) {
@@ -266,10 +259,10 @@ void GaussianBlur8u::apply(const cv::Mat& src, cv::Mat& dst) {
   dst.create(H, W, CV_8UC1);
   if (dst.data == src.data) throw std::invalid_argument("GaussianBlur8u: dst must not be src");
 #if defined(__GNUC__) && defined(__x86_64__)
-  static const bool avx2 = cpuHasAvx2();
+  static const bool avx2 = cpu::hasAvx2Fma();
   auto rows = avx2 ? rowSumsAvx2 : rowSums;
   auto columns = avx2 ? columnSumsAvx2 : columnSums;
-  static const bool avx512_cpu = avx2 && cpuHasAvx512();
+  static const bool avx512_cpu = avx2 && cpu::hasAvx512f();
   const bool avx512 = avx512_cpu && simd_ >= 2;
   auto frows = avx512 ? floatRowAvx512 : avx2 && simd_ >= 1 ? floatRowAvx2 : floatRow;
   auto fcolumns = avx512 ? floatColumnAvx512 : avx2 && simd_ >= 1 ? floatColumnAvx2 : floatColumn;

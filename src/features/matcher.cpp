@@ -11,6 +11,7 @@
 #include "spinradar/features/matcher.hpp"
 
 #include "matcher_kernels.hpp"
+#include "cpu_support.hpp"
 
 #include <algorithm>
 #include <climits>
@@ -113,15 +114,6 @@ void matchScalar(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<
 }
 
 namespace {
-bool cpuHasAvx512Popcnt() {
-#if defined(__GNUC__) && defined(__x86_64__)
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vpopcntdq") &&
-         __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
-#else
-  return false;
-#endif
-}
 
 #if defined(__GNUC__) && defined(__x86_64__)
 // GCC 12's AVX-512 min/max/reduce intrinsics pass an "undefined" source register that it then
@@ -210,10 +202,6 @@ SPINRADAR_AVX512 void match32Avx512(const cv::Mat& d1, const cv::Mat& d2, double
 #pragma GCC diagnostic pop
 #endif
 
-bool cpuHasAvx2() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2");
-}
 
 /// Per-byte popcount of x (nibble table lookup).
 __attribute__((target("avx2"))) inline __m256i byteCount(__m256i x, __m256i lut, __m256i nib) {
@@ -274,7 +262,7 @@ __attribute__((target("avx2,popcnt"))) void match32Avx2(const cv::Mat& d1, const
 
 bool matchAvx2(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Match>& out) {
 #if defined(__GNUC__) && defined(__x86_64__)
-  static const bool supported = cpuHasAvx2();
+  static const bool supported = cpu::hasAvx2();
   if (!supported || d1.cols != 32) return false;
   thread_local std::vector<uint64_t> soa;
   match32Avx2(d1, d2, nndr, out, soa);
@@ -286,7 +274,7 @@ bool matchAvx2(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Ma
 
 bool matchAvx512(const cv::Mat& d1, const cv::Mat& d2, double nndr, std::vector<Match>& out) {
 #if defined(__GNUC__) && defined(__x86_64__)
-  static const bool supported = cpuHasAvx512Popcnt();
+  static const bool supported = cpu::hasAvx512Popcnt();
   if (!supported || d1.cols != 32) return false;
   thread_local std::vector<uint64_t> soa;
   match32Avx512(d1, d2, nndr, out, soa);
