@@ -194,8 +194,12 @@ struct Odometry::Impl {
   }
 
   /// Estimation and compounding on cur (prev is the previous scan, when there is one).
-  OdometryResult step(StageTimes times) {
-    OdometryResult res;
+  void step(StageTimes times, OdometryResult& res) {
+    std::vector<int> inliers;  // keeps the caller's buffer: no allocation once it has grown
+    inliers.swap(res.motion.inliers);
+    res = OdometryResult{};
+    inliers.clear();
+    res.motion.inliers.swap(inliers);
     res.stamp_ns = cur.frame.stamp_ns;
     if (has_prev) checkTime(res);
     const std::vector<Keypoint>& kps = cur.frame.keypoints;
@@ -296,7 +300,6 @@ struct Odometry::Impl {
     res.times = times;
     std::swap(prev, cur);
     has_prev = true;
-    return res;
   }
 
   /// surface: the keyframe estimator on its own chain gives the predicted step (m.T_12 on
@@ -339,12 +342,18 @@ Odometry::Odometry(Odometry&&) noexcept = default;
 Odometry& Odometry::operator=(Odometry&&) noexcept = default;
 
 OdometryResult Odometry::process(const PolarScan& scan) {
+  OdometryResult res;
+  process(scan, res);
+  return res;
+}
+
+void Odometry::process(const PolarScan& scan, OdometryResult& out) {
   Impl& d = *impl_;
   if (!d.extractor)
     d.extractor = std::make_unique<FeatureExtractor>(d.config.detector, d.config.features);
   StageTimes times;
   extractFeatures(d.config, *d.extractor, scan, d.cur.frame, &times);
-  return d.step(times);
+  d.step(times, out);
 }
 
 void Odometry::extractFeatures(const PipelineConfig& config, FeatureExtractor& extractor,
@@ -354,9 +363,15 @@ void Odometry::extractFeatures(const PipelineConfig& config, FeatureExtractor& e
 }
 
 OdometryResult Odometry::process(const FeatureFrame& frame, const StageTimes& times) {
+  OdometryResult res;
+  process(frame, times, res);
+  return res;
+}
+
+void Odometry::process(const FeatureFrame& frame, const StageTimes& times, OdometryResult& out) {
   Impl& d = *impl_;
   d.cur.copyFrom(frame);
-  return d.step(times);
+  d.step(times, out);
 }
 
 const std::vector<Eigen::Vector2d>& Odometry::correctedPoints() const { return impl_->corrected; }

@@ -305,6 +305,7 @@ void run(OdometryArgs& a) {
       if (p) p->release();
     }
   };
+  OdometryResult r;  // reused: its inliers keep their buffer (no allocation per scan)
   for (size_t i = 0; i < folder.size(); ++i) {
     if (!prefetch) ScanPrefetcher::loadInto(folder, i, single);
     ScanPrefetcher::Loaded& l = prefetch ? prefetcher->take(wait_ms) : single;
@@ -322,7 +323,10 @@ void run(OdometryArgs& a) {
     }
     ++processed;
     if (!l.extract_error.empty()) throw std::runtime_error(l.extract_error);
-    const OdometryResult r = prefetch ? odometry.process(l.frame, l.times) : odometry.process(l.scan);
+    if (prefetch)
+      odometry.process(l.frame, l.times, r);
+    else
+      odometry.process(l.scan, r);
     totals += r.times;
     if (i > 0 && !r.ok) ++failures;
     PoseRecord p;

@@ -37,6 +37,10 @@ class Odometry {
   /// Estimation only, for features computed elsewhere (the feature nodelet, or extractFeatures()
   /// on a loader thread); `times` (detect, Cartesian, describe) is passed through to the result.
   OdometryResult process(const FeatureFrame& frame, const StageTimes& times = {});
+  /// The same two, writing into `out` (overwritten whole) and reusing its buffers (the
+  /// inliers): a caller that keeps `out` across scans makes no allocation per scan once warm.
+  void process(const PolarScan& scan, OdometryResult& out);
+  void process(const FeatureFrame& frame, const StageTimes& times, OdometryResult& out);
   /// The per-scan part of process(scan): features and keypoint times from the scan and
   /// `config` alone (no estimator state), so another thread may run it ahead with its own
   /// extractor (made from config.detector, config.features); process(frame) on the result
