@@ -75,7 +75,8 @@ class EstimatorNodelet : public nodelet::Nodelet {
       NODELET_ERROR("dropping features at %.3f: %s", msg->header.stamp.toSec(), e.what());
       return;
     }
-    const spinradar::OdometryResult result = odometry_->process(frame_);
+    odometry_->process(frame_, {}, result_);  // into the kept result: no allocation per scan
+    const spinradar::OdometryResult& result = result_;
     using TimeEvent = spinradar::OdometryResult::TimeEvent;
     if (result.time_event == TimeEvent::Backwards)
       NODELET_WARN("scan at %.3f: time went back by %.3f s: odometry state reset, pose kept "
@@ -128,6 +129,7 @@ class EstimatorNodelet : public nodelet::Nodelet {
   spinradar::PipelineConfig config_;
   std::unique_ptr<spinradar::Odometry> odometry_;
   spinradar::FeatureFrame frame_;
+  spinradar::OdometryResult result_;
   OdometryFrames frames_;
   std::string radar_frame_;
   bool publish_tf_ = true, mounting_known_ = false;

@@ -81,7 +81,9 @@ TEST(KeyframeAllocations, NoneIntoAKeptResult) {
       EXPECT_EQ(r.ok, k > 0);
       EXPECT_EQ(r.T_world_sensor, first[k].T_world_sensor) << k;
       EXPECT_EQ(r.motion.inliers, first[k].motion.inliers) << k;
-      if (k > 0) EXPECT_GT(r.motion.inliers.size(), 100u);  // filled, not left empty
+      if (k > 0) {
+        EXPECT_GT(r.motion.inliers.size(), 100u);  // filled, not left empty
+      }
     }
     return allocations;
   };
