@@ -12,7 +12,7 @@ namespace {
 
 struct Replicate {
   std::array<double, kBands> floor{}, mean{}, bright{}, cfar{};
-  double beam = NAN, psf = NAN, behind = NAN;
+  double beam = NAN, psf = NAN, behind = NAN, near = NAN;
   int peaks = 0;
   bool masked = false;  ///< all its rows invalid (held out): not a replicate
 };
@@ -192,12 +192,13 @@ AppearanceFigures measureAppearance(const std::vector<PolarScan>& scans) {
       std::copy(full.row(q * rows), full.row(q * rows) + size_t(rows) * full.bins, s.power.begin());
       Replicate r;
       std::vector<std::vector<double>> h(kBands, std::vector<double>(256, 0.0));
+      double rnear = 0, rnear_n = 0;
       for (int a = 0; a < rows; ++a) {
         const uint8_t* row = s.row(a);
         double rs = 0, rn = 0;
         for (int b = 0; b < s.bins; ++b) {
           const double range = s.rangeOfBin(b);
-          if (range < 2.0 && range > 0) near += row[b], near_n += 1;
+          if (range < 2.0 && range > 0) near += row[b], near_n += 1, rnear += row[b], rnear_n += 1;
           int k = bandOf(range);
           if (k >= 0) h[k][row[b]] += 1;
           if (k == 3) rs += row[b], rn += 1;
@@ -206,6 +207,7 @@ AppearanceFigures measureAppearance(const std::vector<PolarScan>& scans) {
       }
       for (int k = 0; k < kBands; ++k) histFigures(h[k], r.floor[k], r.mean[k], r.bright[k]);
       floor0 += r.floor[0];
+      if (rnear_n > 0) r.near = rnear / rnear_n - r.floor[0];
       double cf[4] = {0, 0, 0, 0};
       sim::countPlainCaCfar(s, sim::kBandEdges[0], sim::kBandEdges[kBands], cf);
       for (int k = 0; k < kBands; ++k) r.cfar[k] = std::log10(1.0 + Q * cf[k]);
@@ -270,6 +272,10 @@ AppearanceFigures measureAppearance(const std::vector<PolarScan>& scans) {
   collect([](const Replicate& r) { return r.beam; }, f.beam_rows, f.beam_rows_se);
   collect([](const Replicate& r) { return r.psf; }, f.psf_bins, f.psf_bins_se);
   collect([](const Replicate& r) { return r.behind; }, f.behind, f.behind_se);
+  {
+    double m = 0;
+    collect([](const Replicate& r) { return r.near; }, m, f.near_excess_se);
+  }
   for (const auto& r : reps) {
     f.peaks += r.peaks;
     std::vector<double> v;

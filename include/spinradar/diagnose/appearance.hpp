@@ -35,6 +35,7 @@ struct AppearanceFigures {
   double az_sidelobe_db = 0;   ///< mean level 3-6 rows off strong peaks, dB below the peak
   double rng_sidelobe_db = 0;  ///< mean level 10-20 bins off strong peaks, dB below the peak
   double near_excess = 0;      ///< mean count below 2 m minus the 2.5-10 m floor (leakage)
+  double near_excess_se = 0;   ///< its standard error from the scan quarters
   double top_count = 0;        ///< largest count present
   double pileup = 0;           ///< cells at top_count / mean cells at the 3 values below it
   double behind = 0, behind_se = 0;  ///< share of bright cells >= 2 m behind the first strong hit
