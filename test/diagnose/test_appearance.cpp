@@ -87,8 +87,9 @@ INSTANTIATE_TEST_SUITE_P(
         // reached through the level pre-alignment.
         Case{"noise_floor_25dB", "noise_floor_db", 33.0, 1.0,
              [](sim::SensorConfig& s, sim::PhysicsConfig&, double) { s.noise_floor_db += 25; }},
-        Case{"leakage", "leakage_db", 30.0, 1.0,
-             [](sim::SensorConfig& s, sim::PhysicsConfig&, double) { s.leakage_db = 30; }},
+        // 20 dB over the noise at 0 m, 10 dB less per metre: down to the noise at 2 m.
+        Case{"leakage", "leakage_db", 20.0, 1.0,
+             [](sim::SensorConfig& s, sim::PhysicsConfig&, double) { s.leakage_db = 20; }},
         Case{"saturation", "saturation", 0, 1.0,
              [](sim::SensorConfig& s, sim::PhysicsConfig&, double top) { s.saturation = top - 20; }},
         Case{"ghosts", "multipath", -15.0, 1.0,
