@@ -143,11 +143,13 @@ DriftResult kittiDrift(const std::vector<Eigen::Matrix3d>& gt,
   r.r_err_deg_per_m = kRadToDeg * re / r.segments.size();
 
   // Devkit's saveErrorPlots: per length |len - L| < 1, per speed |v - c| < 2, keep num > 2.5.
-  for (double len : cfg.lengths) {
+  // Mean errors of the segments whose `value` lies within `half_width` of `key`.
+  const auto addBin = [&](double key, double half_width, double SegmentError::*value,
+                          std::vector<DriftBin>& bins) {
     DriftBin b;
-    b.key = len;
+    b.key = key;
     for (const auto& s : r.segments)
-      if (std::fabs(s.length - len) < 1.0) {
+      if (std::fabs(s.*value - key) < half_width) {
         b.t_err_pct += s.t_err;
         b.r_err_deg_per_m += s.r_err;
         ++b.count;
@@ -155,24 +157,12 @@ DriftResult kittiDrift(const std::vector<Eigen::Matrix3d>& gt,
     if (b.count >= cfg.min_segments_per_bin) {
       b.t_err_pct *= 100.0 / b.count;
       b.r_err_deg_per_m *= kRadToDeg / b.count;
-      r.by_length.push_back(b);
+      bins.push_back(b);
     }
-  }
-  for (double c : cfg.speed_centres) {
-    DriftBin b;
-    b.key = c;
-    for (const auto& s : r.segments)
-      if (std::fabs(s.speed - c) < cfg.speed_half_width) {
-        b.t_err_pct += s.t_err;
-        b.r_err_deg_per_m += s.r_err;
-        ++b.count;
-      }
-    if (b.count >= cfg.min_segments_per_bin) {
-      b.t_err_pct *= 100.0 / b.count;
-      b.r_err_deg_per_m *= kRadToDeg / b.count;
-      r.by_speed.push_back(b);
-    }
-  }
+  };
+  for (double len : cfg.lengths) addBin(len, 1.0, &SegmentError::length, r.by_length);
+  for (double c : cfg.speed_centres)
+    addBin(c, cfg.speed_half_width, &SegmentError::speed, r.by_speed);
   return r;
 }
 

@@ -16,7 +16,8 @@ inline bool hasAvx512f() {
 inline bool hasAvx512bw() { return hasAvx512f() && __builtin_cpu_supports("avx512bw"); }
 /// What the matcher's kernel needs: AVX-512 with byte/word ops, vector popcount and 256-bit forms.
 inline bool hasAvx512Popcnt() {
-  return hasAvx512bw() && __builtin_cpu_supports("avx512vpopcntdq") && __builtin_cpu_supports("avx512vl");
+  return hasAvx512bw() && __builtin_cpu_supports("avx512vpopcntdq") &&
+         __builtin_cpu_supports("avx512vl");
 }
 }  // namespace spinradar::cpu
 #endif
