@@ -1,5 +1,6 @@
 #pragma once
 // Internals of the appearance stage (src/diagnose/appearance_*.cpp).
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,11 @@ Eigen::VectorXd figureSe(const AppearanceFigures& f);
 /// number of replicates (same route), otherwise from the two standard errors.
 Eigen::VectorXd differenceSe(const AppearanceFigures& a, const AppearanceFigures& b);
 
+/// Moves the noise floor and receiver gain of `cur` straight to the recording's level when the
+/// gaps exceed what the fit's trust region covers (notes say so); figuresOf re-simulates.
+void alignLevels(const AppearanceFigures& real, sim::SensorConfig& cur,
+                 const std::function<AppearanceFigures(const sim::SensorConfig&)>& figuresOf,
+                 std::vector<std::string>& notes);
 /// Fills rep.locate from rep.real / rep.before.
 void locateAppearance(AppearanceReport& rep);
 /// Realism figures of the recording and of the reference re-simulated before/after the fit.
