@@ -217,12 +217,16 @@ struct Odometry::Impl {
       t0 = std::chrono::steady_clock::now();
       MotionEstimate& m = res.motion;
       bool ok = estimate(m);
-      if (!ok && has_last && usesRefinedChain()) {
-        // Descriptors failed (a turn faster than upright ORB follows, see pair_recovery.hpp):
-        // register the scan to the previous one's points around the last velocity instead of
-        // predicting with it. Only on failure: also trying pairs with few inliers (< 5, 10,
-        // 20) was measured worse (out_and_back layout 2, keyframe: 1.09 % against 1.73-1.86 %;
-        // tight_turns 3.93 % against 4.54 % with < 20).
+      // Descriptors failed (a turn faster than upright ORB follows, see pair_recovery.hpp),
+      // or "succeeded" on a handful of chance matches: register the scan to the previous
+      // one's points around the last velocity instead. A pair with fewer than
+      // kMinPairInliers inliers is no registration: at the eased U-turn of out_and_back
+      // (21 deg per scan) MC-RANSAC returned 9 deg on 3 inliers, and the refined chain came
+      // out 12 deg off (keyframe 8.0 % -> 1.2 %, refined 6.4 -> 1.1 %, surface 8.3 -> 1.5 %;
+      // no other column moved). Not for weak pairs: with < 10 / < 20 the peaks rows lost
+      // (out_and_back_v2 0.14 -> 0.17-0.18 %) as the point registration replaced good pairs.
+      if ((!ok || static_cast<int>(m.inliers.size()) < PairRecovery::kMinPairInliers) && has_last &&
+          usesRefinedChain()) {
         MotionEstimate r;
         if (recovery.estimate(prev.frame, cur.frame, last.velocity, r)) {
           m = r;

@@ -51,6 +51,9 @@ void addTree(World& w, Rng& rng, double cx, double cy, double radius) {
 /// Builds a motion profile: speed ramps, straights and constant-radius turns.
 class Route {
  public:
+  static constexpr double kYawAccel = kSceneYawAccel;
+  static constexpr double kRampStep = 0.01;  ///< s per constant-yaw-rate step of a ramp
+
   explicit Route(double v0 = 0) : v_(v0) {}
   /// Ramp the speed to v1 at |accel| (m/s^2); returns the distance covered.
   double ramp(double v1, double accel) {
@@ -74,10 +77,24 @@ class Route {
     if (v_ <= 1e-6) throw std::logic_error("route: straight at zero speed");
     seg_.push_back({dist / v_, v_, 0.0});
   }
-  /// Turn by angle (rad, + = left/CCW) on a circle of radius r at the current speed.
+  /// Turn by angle (rad, + = left/CCW) at the current speed: the yaw rate ramps at
+  /// kYawAccel up to v / r (a circle of radius r), holds, and ramps back to zero, so the
+  /// path eases in and out as a driver turning the wheel does (no vehicle steps its yaw rate).
   void turn(double angle, double r) {
-    double w = v_ / r * (angle > 0 ? 1 : -1);
-    seg_.push_back({std::abs(angle) / std::abs(w), v_, w});
+    for (const auto& s : turnProfile(v_, angle, r)) seg_.push_back(s);
+  }
+  /// Distance from the start of turn(angle, r) at speed v to where the entry and exit
+  /// directions cross (r tan(angle / 2) for a circle; longer with the eased entry and exit).
+  static double tangentLength(double v, double angle, double r) {
+    if (std::abs(std::sin(angle)) < 1e-3) throw std::logic_error("route: tangent of a U-turn");
+    double x = 0, y = 0, yaw = 0;
+    for (const auto& s : turnProfile(v, angle, r)) {  // exact arcs, as Trajectory::fromProfile
+      const double w = s.yaw_rate, next = yaw + w * s.duration;
+      x += s.speed / w * (std::sin(next) - std::sin(yaw));
+      y += s.speed / w * (std::cos(yaw) - std::cos(next));
+      yaw = next;
+    }
+    return x - y * std::cos(angle) / std::sin(angle);
   }
   void wait(double dur) { seg_.push_back({dur, 0.0, 0.0}); }
   /// A leg of `dist` starting at speed v_ and ending at v_end, cruising at up to v_cruise.
@@ -98,6 +115,26 @@ class Route {
   const std::vector<Trajectory::Segment>& segments() const { return seg_; }
 
  private:
+  static std::vector<Trajectory::Segment> turnProfile(double v, double angle, double r) {
+    if (v <= 1e-6) throw std::logic_error("route: turn at zero speed");
+    const double sign = angle > 0 ? 1 : -1, total = std::abs(angle);
+    // Trapezoid in yaw rate; a triangle when the turn is too short to reach v / r.
+    double w = v / r, t_ramp = w / kYawAccel;
+    if (w * t_ramp > total) {
+      w = std::sqrt(total * kYawAccel);
+      t_ramp = w / kYawAccel;
+    }
+    const double t_hold = total / w - t_ramp;
+    const int n = std::max(1, int(std::ceil(t_ramp / kRampStep)));
+    const double dt = t_ramp / n;
+    std::vector<Trajectory::Segment> out;
+    // Each ramp step holds the rate at its midpoint: the ramps turn by exactly w * t_ramp.
+    for (int i = 0; i < n; ++i) out.push_back({dt, v, sign * w * (i + 0.5) / n});
+    if (t_hold > 1e-9) out.push_back({t_hold, v, sign * w});
+    for (int i = n - 1; i >= 0; --i) out.push_back({dt, v, sign * w * (i + 0.5) / n});
+    return out;
+  }
+
   double v_;
   std::vector<Trajectory::Segment> seg_;
 };
@@ -212,7 +249,8 @@ Scene city(uint64_t variant, double t0) {
   for (int k = 0; k + 1 < nn; ++k) {
     double len = (std::abs(nodes[k + 1][0] - nodes[k][0]) + std::abs(nodes[k + 1][1] - nodes[k][1])) * P;
     bool last = k + 2 == nn;
-    double out_turn = last ? 0.0 : R;
+    // The turn starts its tangent length before the crossing, so the car stays mid-street.
+    double out_turn = last ? 0.0 : Route::tangentLength(v_turn, M_PI / 2, R);
     double v_cruise = uni(rng, 10.0, 15.0);
     route.leg(len - in_turn - out_turn, v_cruise, last ? 0.0 : v_turn, 2.0, 2.5);
     if (!last) {
@@ -220,7 +258,7 @@ Scene city(uint64_t variant, double t0) {
       double nx = nodes[k + 2][0] - nodes[k + 1][0], ny = nodes[k + 2][1] - nodes[k + 1][1];
       double cross = ((hx > 0) - (hx < 0)) * ((ny > 0) - (ny < 0)) - ((hy > 0) - (hy < 0)) * ((nx > 0) - (nx < 0));
       route.turn(cross > 0 ? M_PI / 2 : -M_PI / 2, R);
-      in_turn = R;
+      in_turn = out_turn;
     }
   }
   route.wait(1.0);
@@ -258,12 +296,12 @@ Scene outAndBack(uint64_t variant, double t0) {
   route.leg(300, 15.0, 15.0, 2.0, 2.0);
   route.leg(300, 20.0, 20.0, 1.5, 2.0);
   route.leg(320, 12.0, 3.0, 2.0, 2.0);
-  route.turn(M_PI, 2.0);  // U-turn onto the other lane (y -2 -> +2)
+  route.turn(M_PI, 2.0);  // U-turn onto the other lane (y -2.4 -> +2.4 with the eased ends)
   route.leg(300, 12.0, 12.0, 2.0, 2.0);
   route.leg(300, 18.0, 18.0, 1.5, 2.0);
   route.leg(320, 10.0, 0.0, 2.0, 2.0);
   route.wait(1.0);
-  sc.trajectory = Trajectory::fromProfile(route.segments(), {0, -2, 0}, t0);
+  sc.trajectory = Trajectory::fromProfile(route.segments(), {0, -2.4, 0}, t0);
   return sc;
 }
 

@@ -225,3 +225,29 @@ TEST(SimFormats, BuiltinScenesExistAndUnknownNamesAreRejected) {
   }
   EXPECT_THROW(builtinScene("moon"), std::invalid_argument);
 }
+
+// No vehicle steps its yaw rate: the built-in routes ramp it, and the city route's eased
+// turns still leave the car on a street's centre line (streets every 64 m) on every straight.
+TEST(SimScenes, YawRateRampsAndCityStraightsStayMidStreet) {
+  for (const auto& n : builtinSceneNames()) {
+    const Trajectory tr = builtinScene(n).trajectory;
+    // Rates 50 ms apart: the ramps are steps of 10 ms, a stepped turn changes within 10 ms.
+    const double dt = 0.05;
+    double worst_accel = 0, max_rate = 0, off_centre = 0;
+    double prev = tr.bodyVelocity(tr.startTime() + 0.005)[2];
+    for (double t = tr.startTime() + 0.005 + dt; t < tr.endTime() - 0.01; t += dt) {
+      const Eigen::Vector3d v = tr.bodyVelocity(t);
+      worst_accel = std::max(worst_accel, std::abs(v[2] - prev) / dt);
+      max_rate = std::max(max_rate, std::abs(v[2]));
+      prev = v[2];
+      if (n == "city" && std::abs(v[2]) < 1e-9 && v[0] > 1.0) {
+        const Pose2 p = tr.at(t);
+        auto toLine = [](double u) { return std::abs(u - 64.0 * std::round(u / 64.0)); };
+        off_centre = std::max(off_centre, std::min(toLine(p.x), toLine(p.y)));
+      }
+    }
+    EXPECT_GT(max_rate, 0.5) << n;                            // it does turn
+    EXPECT_LT(worst_accel, 1.25 * kSceneYawAccel) << n;        // a step would be ~60 rad/s^2
+    EXPECT_LT(off_centre, 0.05) << n;                         // (0 for the other scenes)
+  }
+}

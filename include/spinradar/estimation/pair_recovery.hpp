@@ -68,6 +68,8 @@ class PairRecovery {
   static constexpr int kSearchPoints = 400;    ///< scan points scored per candidate (strided)
   static constexpr int kIterations = 12;
   static constexpr int kMinInliers = 30;
+  /// A descriptor pair with fewer MC-RANSAC inliers than this is tried here too (odometry.cpp).
+  static constexpr int kMinPairInliers = 5;
   /// The search's best candidate must explain this fraction of the scored points: a scene
   /// the map does not share (or noise) never gets a recovered step.
   static constexpr double kMinFraction = 0.2;

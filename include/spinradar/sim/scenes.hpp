@@ -7,6 +7,7 @@
 //                  U-turn, and back on the other lane
 //   "tight_turns"  an open yard with poles, containers and walls; slalom and tight loops
 //                  (yaw rates up to ~1 rad/s) at 3-8 m/s
+// Turns ease in and out: the yaw rate ramps at kSceneYawAccel, never steps.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -14,6 +15,10 @@
 #include "spinradar/sim/scene.hpp"
 
 namespace spinradar::sim {
+
+/// Largest yaw acceleration of the built-in routes (rad/s^2): a 0.6 rad/s city turn eases in
+/// over 0.6 s, a 1 rad/s loop over 1 s (at 5 m/s about 500 deg/s at the steering wheel).
+constexpr double kSceneYawAccel = 1.0;
 
 struct Scene {
   std::string name;
