@@ -1,5 +1,6 @@
 #pragma once
 // Internals of the appearance stage (src/diagnose/appearance_*.cpp).
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -42,5 +43,24 @@ void locateAppearance(AppearanceReport& rep);
 /// Realism figures of the recording and of the reference re-simulated before/after the fit.
 void realismBeforeAfter(const std::vector<PolarScan>& real, const std::vector<PolarScan>& holdout,
                         const AppearanceOptions& opt, AppearanceReport& rep);
+
+bool physicsHasGhosts(const sim::PhysicsConfig& p);
+AppearanceFinding makeFinding(const std::string& effect, const std::string& param,
+                              const std::string& unit, double base, double value, double sd,
+                              double size, const std::string& size_unit, bool practical,
+                              double z_min);
+
+/// Speckle of extended targets (appearance_speckle.cpp): mean jump of the counts between
+/// neighbouring bright cells (15 counts over the floor; next bin and next row) at 10-100 m, its
+/// standard error from the scan quarters.
+struct Roughness {
+  double value = NAN, se = 0, pairs = 0;
+};
+Roughness returnRoughness(const std::vector<PolarScan>& scans);
+/// Fits return_speckle by bisection on re-simulations of the reference scene; sets it in `cur`
+/// when named.
+AppearanceFinding fitReturnSpeckle(const std::vector<PolarScan>& real, sim::SensorConfig& cur,
+                                   const sim::PhysicsConfig& phys, const AppearanceOptions& opt,
+                                   std::vector<std::string>& notes);
 
 }  // namespace spinradar::diagnose::detail

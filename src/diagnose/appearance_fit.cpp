@@ -20,31 +20,11 @@ namespace spinradar::diagnose {
 using sim::SensorConfig;
 
 namespace {
-
+using detail::alignLevels;
 using detail::appearanceParams;
 using detail::Kind;
-using detail::alignLevels;
-
-bool physicsHasGhosts(const sim::PhysicsConfig& p) {
-  auto it = p.extra.find("multipath");
-  return it != p.extra.end() && !it->is_null() && !(it->is_boolean() && !it->get<bool>());
-}
-
-AppearanceFinding makeFinding(const std::string& effect, const std::string& param,
-                              const std::string& unit, double base, double value, double sd,
-                              double size, const std::string& size_unit, bool practical,
-                              double z_min) {
-  AppearanceFinding f;
-  f.effect = effect, f.parameter = param, f.unit = unit;
-  f.base = base, f.value = value, f.stddev = sd;
-  f.z = sd > 0 ? std::abs(value - base) / sd : 0;
-  f.size = size, f.size_unit = size_unit;
-  const bool sig = f.z >= z_min;
-  f.named = sig && practical;
-  f.verdict = f.named ? "mismatch" : sig ? "negligible" : "not significant";
-  return f;
-}
-
+using detail::makeFinding;
+using detail::physicsHasGhosts;
 }  // namespace
 
 AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
@@ -383,6 +363,10 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
     f.gap_after = e_real[fi] - e_cur[fi];
     rep.findings.push_back(f);
   }
+
+  // --- Speckle of extended targets (appearance_speckle.cpp), before the range curves.
+  rep.findings.push_back(detail::fitReturnSpeckle(real, cur, phys, opt, rep.notes));
+  if (rep.findings.back().named) rep.after = figuresOf(cur, phys);
 
   // --- Per-band calibration: range curves on the per-band realism figures.
   if (opt.realism && opt.curve_iterations > 0) {
