@@ -50,16 +50,18 @@ AppearanceFinding makeFinding(const std::string& effect, const std::string& para
                               double size, const std::string& size_unit, bool practical,
                               double z_min);
 
-/// Speckle of extended targets (appearance_speckle.cpp): mean jump of the counts between
-/// neighbouring bright cells (15 counts over the floor; next bin and next row) at 10-100 m, its
-/// standard error from the scan quarters.
-struct Roughness {
-  double value = NAN, se = 0, pairs = 0;
+/// A figure of the texture, its standard error from the replicates (scan quarters) and the
+/// replicates themselves (recordings of the same route are compared replicate by replicate).
+struct TextureFigure {
+  double value = NAN, se = 0;
+  std::vector<double> replicates;
 };
-Roughness returnRoughness(const std::vector<PolarScan>& scans);
-/// Fits return_speckle by bisection on re-simulations of the reference scene; sets it in `cur`
-/// when named.
-AppearanceFinding fitReturnSpeckle(const std::vector<PolarScan>& real, sim::SensorConfig& cur,
+/// Range correlation of the counts at `lag` bins over 10-100 m (row means removed), in
+/// appearance_texture.cpp.
+TextureFigure rangeCorrelation(const std::vector<PolarScan>& scans, int lag);
+/// Fits noise_texture_bins (whole bins) to the range correlation beyond the range spread; sets
+/// it in `cur` when named. Not identifiable without a noise texture.
+AppearanceFinding fitTextureLength(const std::vector<PolarScan>& real, sim::SensorConfig& cur,
                                    const sim::PhysicsConfig& phys, const AppearanceOptions& opt,
                                    std::vector<std::string>& notes);
 

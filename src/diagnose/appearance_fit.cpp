@@ -84,8 +84,7 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
   if (opt.fit_clutter && cur.clutter_density <= 0) cur.clutter_density = 0.05;  // start points
   if (opt.fit_near_stc && cur.stc_range <= 0) cur.stc_range = 10.0;
   if (opt.fit_clutter && cur.noise_texture_db <= 0) cur.noise_texture_db = 1.0;
-  alignLevels(rep.real, cur, [&](const SensorConfig& s) { return figuresOf(s, phys); },
-              rep.notes);
+  alignLevels(rep.real, cur, [&](const SensorConfig& s) { return figuresOf(s, phys); }, rep.notes);
   const bool moved = cur.radar_constant_db != sensor.radar_constant_db ||
                      cur.noise_floor_db != sensor.noise_floor_db ||
                      cur.noise_range_slope_db_per_decade != sensor.noise_range_slope_db_per_decade ||
@@ -364,8 +363,8 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
     rep.findings.push_back(f);
   }
 
-  // --- Speckle of extended targets (appearance_speckle.cpp), before the range curves.
-  rep.findings.push_back(detail::fitReturnSpeckle(real, cur, phys, opt, rep.notes));
+  // --- Noise texture correlation (appearance_texture.cpp), before the range curves.
+  rep.findings.push_back(detail::fitTextureLength(real, cur, phys, opt, rep.notes));
   if (rep.findings.back().named) rep.after = figuresOf(cur, phys);
 
   // --- Per-band calibration: range curves on the per-band realism figures.

@@ -148,18 +148,6 @@ RenderModel::RenderModel(const SensorConfig& s) : s_(s) {
       mean += pw[i];
     }
     mean /= ns;
-    // Speckle of extended targets: the coherent sum of the many scatterers a resolution cell
-    // holds (walls, ground) is exponential in power too, not the incoherent sum of their powers.
-    if (s.return_speckle > 0) {
-      return_speckle_.resize(ns);
-      const double f = s.return_speckle;
-      double lm = 0;
-      for (int i = 0; i < ns; ++i) lm += std::log((1 - f) + f * pw[i] / mean);
-      // Scaled so that the mean log power (the mean count) of a return is kept: the level
-      // curves stay what they were, only the spread grows.
-      const double k = std::exp(-lm / ns);
-      for (int i = 0; i < ns; ++i) return_speckle_[i] = float(k * ((1 - f) + f * pw[i] / mean));
-    }
     // Texture: a slow log-normal modulation of the speckle power (range-correlated over
     // noise_texture_bins), which gives the heavy tails real clutter and noise show; the mean
     // power is kept.

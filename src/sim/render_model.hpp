@@ -87,11 +87,6 @@ class RenderModel {
   float speckleLin(uint32_t i) const { return speckle_lin_[i & kSpeckleMask]; }
   int16_t speckleQ(uint32_t i) const { return speckle_q_[i & kSpeckleMask]; }
   const int16_t* speckleQData() const { return speckle_q_.data(); }
-  /// Speckle of extended targets (return_speckle > 0): the return power of a bin is scaled by
-  /// k ((1 - f) + f E), E unit-mean exponential speckle (range-correlated like the noise speckle,
-  /// without its texture), k keeping the mean log power. Empty when f = 0.
-  bool hasReturnSpeckle() const { return !return_speckle_.empty(); }
-  float returnSpeckle(uint32_t i) const { return return_speckle_[i & kSpeckleMask]; }
   /// Largest per-azimuth level offset (1/8 dB) the count table is sized for.
   static constexpr int kMaxRowOffsetQ = 160;
   /// Count table indexed directly by a level in 1/8 dB: noise level + speckle + row offset
@@ -137,7 +132,6 @@ class RenderModel {
   std::vector<int16_t> noise_q_;
   std::vector<float> speckle_lin_;
   std::vector<int16_t> speckle_q_;
-  std::vector<float> return_speckle_;  ///< (1 - f) + f * E per sample, or empty
   int q_min_ = 0;
   std::vector<uint8_t> lut_;
   float log2_mant_[1024];

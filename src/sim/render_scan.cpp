@@ -364,11 +364,6 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
     uint8_t* o = out.row(a);
     const uint8_t* table = count_table + dq;
     const int16_t* sq = speckle_q + start;
-    // Speckle of the returns: an independent stretch of the speckle table (drawn only when on,
-    // so that the default model renders the same bytes).
-    const bool rs = model.hasReturnSpeckle();
-    const uint32_t rs_start =
-        rs ? uint32_t(rng.next() % uint64_t(detail::RenderModel::kSpeckleMask + 1 - M)) : 0;
     int16_t* lvl = w.level.data();
     for (int b = 0; b < M; ++b) lvl[b] = int16_t(noise_q[b] + sq[b]);  // vectorises
     for (int b = 0; b < M; ++b) o[b] = table[lvl[b]];
@@ -376,7 +371,6 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
       float sig = row[b];
       if (sig == 0.f) continue;
       uint32_t idx = start + uint32_t(b);
-      if (rs) sig *= model.returnSpeckle(rs_start + uint32_t(b));
       o[b] = model.countOfLin(gain * model.noiseLin(b) * model.speckleLin(idx) + sig);
       row[b] = 0.f;  // leave the row clean for the next azimuth
     }

@@ -90,9 +90,6 @@ INSTANTIATE_TEST_SUITE_P(
         // 20 dB over the noise at 0 m, 10 dB less per metre: down to the noise at 2 m.
         Case{"leakage", "leakage_db", 20.0, 1.0,
              [](sim::SensorConfig& s, sim::PhysicsConfig&, double) { s.leakage_db = 20; }},
-        // Speckle of extended targets, 80 % developed: within 10 %.
-        Case{"return_speckle", "return_speckle", 0.8, 0.08,
-             [](sim::SensorConfig& s, sim::PhysicsConfig&, double) { s.return_speckle = 0.8; }},
         Case{"saturation", "saturation", 0, 1.0,
              [](sim::SensorConfig& s, sim::PhysicsConfig&, double top) { s.saturation = top - 20; }},
         Case{"ghosts", "multipath", -15.0, 1.0,

@@ -43,7 +43,6 @@
   X(double, noise_row_jitter_db, 2.0, 0.0, 20.0, "dB", "Std of the per-azimuth noise floor level (AR(1) across azimuths)") \
   X(double, incidence_exponent, 2.0, 0.0, 10.0, "", "Wall back-scatter falls as cos(incidence)^n") \
   X(double, wall_spacing, 0.25, 0.02, 5.0, "m", "Spacing of the scatterers a wall is rendered with") \
-  X(double, return_speckle, 0.0, 0.0, 1.0, "", "Speckle of extended targets: return power scaled by (1 - f) + f * exponential, mean log power kept (1 = fully developed; 0 = off, incoherent sum)") \
   X(double, wall_texture_db, 5.0, 0.0, 20.0, "dB", "Std of the per-scatterer facade texture") \
   X(double, occlusion_tolerance, 0.25, 0.0, 5.0, "m", "Scatterers this far behind the first wall still show") \
   X(double, render_threshold_db, -6.0, -40.0, 20.0, "dB", "Contributions below noise floor + this are skipped") \
