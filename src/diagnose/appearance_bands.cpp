@@ -23,7 +23,8 @@ namespace {
 
 constexpr int kTypes = 3;  // receiver gain curve, return gain curve, clutter density curve
 constexpr int kPerBand = 4;  // mean, q90, CA-CFAR cells, Cen2018 keypoints
-constexpr int kGlobals = 2;  // noise texture (dB), median clutter RCS (dBsm)
+// noise texture (dB), median clutter RCS (dBsm), 10 log2 of the counts per dB (rescaled codes only)
+constexpr int kGlobals = 3;
 constexpr int kRows = kBands * kPerBand, kCols = kTypes * kBands + kGlobals;
 
 double* node(SensorConfig& s, int type, int j) {
@@ -42,7 +43,7 @@ double* node(SensorConfig& s, int type, int j) {
 // type 2 = log2 of the clutter density multiplier.
 double getParam(const SensorConfig& s, int type, int j) {
   SensorConfig& m = const_cast<SensorConfig&>(s);
-  if (type == kTypes) return j == 0 ? s.noise_texture_db : s.clutter_rcs_db;
+  if (type == kTypes) return j == 0 ? s.noise_texture_db : j == 1 ? s.clutter_rcs_db : 10 * std::log2(s.power_scale);
   if (type == 0) return *node(m, 0, j);
   if (type == 1) return *node(m, 0, j) + *node(m, 1, j);
   return std::log2(std::max(*node(m, 2, j), 1.0 / 64));
@@ -51,8 +52,10 @@ void setParam(SensorConfig& s, int type, int j, double p) {
   if (type == kTypes) {
     if (j == 0)
       s.noise_texture_db = std::clamp(p, 0.0, 15.0);
-    else
+    else if (j == 1)
       s.clutter_rcs_db = std::clamp(p, -80.0, 20.0);
+    else if (s.native_codes == 0)  // the native code set pins the counts per dB
+      s.power_scale = std::clamp(std::exp2(p / 10), 0.5, 3.0);
   } else if (type == 2) {
     *node(s, 2, j) = std::clamp(std::exp2(p), 1.0 / 64, 20.0);
   } else if (type == 1) {
@@ -198,6 +201,7 @@ SensorConfig fitRangeCurves(const sim::RealismStats& real, const SensorConfig& s
     refresh = false;
     if (full) for (int c = 0; c < kCols; ++c) {
       const int t = std::min(c / kBands, kTypes), j = c - t * kBands;
+      if (t == kTypes && j == 2 && cur.native_codes != 0) continue;  // column stays zero
       SensorConfig s = cur;
       setParam(s, t, j, getParam(cur, t, j) + step[t]);
       Eigen::VectorXd f;

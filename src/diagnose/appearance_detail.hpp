@@ -65,4 +65,12 @@ AppearanceFinding fitTextureLength(const std::vector<PolarScan>& real, sim::Sens
                                    const sim::PhysicsConfig& phys, const AppearanceOptions& opt,
                                    std::vector<std::string>& notes);
 
+/// Code set of the counts (appearance_texture.cpp): a recording with every code among 1-30
+/// against a model with the native Navtech set is a rescaled product: native_codes = 0 in `cur`
+/// and power_scale started from the spread of the noise side (refined with the range curves).
+AppearanceFinding fitCodeSet(const std::vector<PolarScan>& real, const AppearanceFigures& fr,
+                             const AppearanceFigures& model, sim::SensorConfig& cur,
+                             const sim::PhysicsConfig& phys, const AppearanceOptions& opt,
+                             std::vector<std::string>& notes);
+
 }  // namespace spinradar::diagnose::detail

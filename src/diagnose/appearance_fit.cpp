@@ -70,7 +70,7 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
                           "only bounded from below.");
   }
 
-  // --- Smooth parameters: block-wise Gauss-Newton on the figures. Each block of parameters is
+  rep.findings.push_back(detail::fitCodeSet(real, rep.real, rep.before, cur, phys, opt, rep.notes));  // --- Smooth parameters: block-wise Gauss-Newton on the figures. Each block of parameters is
   // fitted to the figures it moves most (block-diagonal Jacobian from re-simulations with each
   // parameter nudged, common random numbers); the blocks are iterated jointly so that their
   // cross-talk (a wider range spread also changes the CA-CFAR texture) is taken up.
@@ -91,7 +91,8 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
                      cur.range_gain_db_per_decade != sensor.range_gain_db_per_decade ||
                      cur.saturation != sensor.saturation ||
                      cur.clutter_density != sensor.clutter_density ||
-                     cur.stc_range != sensor.stc_range || cur.noise_texture_db != sensor.noise_texture_db;
+                     cur.stc_range != sensor.stc_range || cur.noise_texture_db != sensor.noise_texture_db ||
+                     cur.native_codes != sensor.native_codes || cur.power_scale != sensor.power_scale;
   AppearanceFigures fig_cur = moved ? figuresOf(cur, phys) : rep.before;
   Eigen::VectorXd e_cur = detail::figureVector(fig_cur);
   const Eigen::VectorXd e_real = detail::figureVector(rep.real);

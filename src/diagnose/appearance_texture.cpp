@@ -4,6 +4,7 @@
 // its figure is the range correlation of the counts at 10-100 m beyond the speckle's own (lag
 // twice the range spread), matched by bisection over whole bins on re-simulations.
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "appearance_detail.hpp"
@@ -143,6 +144,68 @@ AppearanceFinding fitTextureLength(const std::vector<PolarScan>& real, SensorCon
     f.gap_after = r.value - simAt(value).value;
   } else {
     f.gap_after = gap;
+  }
+  return f;
+}
+
+namespace {
+
+// Std of the counts at or below the median at 10-100 m (the noise side of the distribution).
+double lowerSpread(const std::vector<PolarScan>& scans) {
+  std::array<double, 256> h{};
+  for (const PolarScan& s : scans) {
+    const int b0 = std::clamp(int(std::ceil(s.binOfRange(10.0))), 0, s.bins - 1);
+    const int b1 = std::clamp(int(std::floor(s.binOfRange(100.0))), b0, s.bins - 1);
+    for (int a = 0; a < s.azimuths; ++a)
+      if (s.valid.empty() || s.valid[a])
+        for (int b = b0; b <= b1; ++b) h[s.row(a)[b]] += 1;
+  }
+  double n = 0;
+  for (double c : h) n += c;
+  double taken = 0, s1 = 0, s2 = 0;
+  for (int c = 0; c < 256 && taken < n / 2; ++c) {
+    const double k = std::min(h[c], n / 2 - taken);
+    taken += k, s1 += k * c, s2 += k * double(c) * c;
+  }
+  if (taken < 2) return NAN;
+  const double mu = s1 / taken;
+  return std::sqrt(std::max(s2 / taken - mu * mu, 0.0));
+}
+
+}  // namespace
+
+AppearanceFinding fitCodeSet(const std::vector<PolarScan>& real, const AppearanceFigures& fr,
+                             const AppearanceFigures& model, SensorConfig& cur,
+                             const sim::PhysicsConfig& phys, const AppearanceOptions& opt,
+                             std::vector<std::string>& notes) {
+  // Native Navtech counts are 20 log10 of an integer amplitude: 19 distinct codes among 1-30 in
+  // the base model (6, 9, 12, 14, ...; the row jitter fills a few more), the Oxford sample 19.
+  // A product rescaled from dB (RADIATE's images) has all 30.
+  AppearanceFinding f;
+  f.effect = "log quantisation (code set)", f.parameter = "native_codes", f.unit = "";
+  f.base = cur.native_codes;
+  f.gap_before = fr.distinct_low_codes - model.distinct_low_codes;
+  f.size = f.gap_before, f.size_unit = "codes among 1-30";
+  const bool rescaled = cur.native_codes != 0 && fr.distinct_low_codes >= 27 &&
+                        fr.distinct_low_codes - model.distinct_low_codes >= 6;
+  f.value = rescaled ? 0 : cur.native_codes;
+  f.z = rescaled ? INFINITY : 0;
+  f.named = rescaled;
+  f.verdict = rescaled ? "mismatch" : "not significant";
+  f.gap_after = rescaled ? 0 : f.gap_before;
+  if (!rescaled) return f;
+  cur.native_codes = 0;
+  // Counts per dB, a start for the range-curve fit (which refines it): the spread of the noise
+  // side of the counts, recording over the model at 1 count per dB (levels do not move it while
+  // the floor is clear of zero). Before the catalogue fit, so that peak widths measured in counts
+  // compare like with like.
+  const double sr = lowerSpread(real), sm = lowerSpread(renderReference(cur, phys, opt, opt.seed));
+  if (std::isfinite(sr) && std::isfinite(sm) && sm > 0) {
+    cur.power_scale = std::clamp(cur.power_scale * sr / sm, 0.5, 3.0);
+    notes.push_back("Rescaled counts (every code among 1-30): native_codes 0; counts per dB from "
+                    "the spread of the noise side, " + std::to_string(sr) + " against " +
+                    std::to_string(sm) + " at 1 count/dB: power_scale " +
+                    std::to_string(cur.power_scale) + " (refined by the range curves).");
   }
   return f;
 }

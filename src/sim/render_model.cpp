@@ -189,6 +189,8 @@ RenderModel::RenderModel(const SensorConfig& s) : s_(s) {
     double a = std::pow(10.0, q / 8.0 / 20.0);
     double n = std::floor(a);
     double c = n >= 1 ? s.power_scale * 20.0 * std::log10(n) : 0.0;
+    // Rescaled products (RADIATE's 8-bit images): the dB value itself, every code present.
+    if (s.native_codes == 0) c = std::max(0.0, s.power_scale * q / 8.0);
     // Receiver compression: above the knee the output grows by compression_ratio per count.
     if (c > s.compression_knee) c = s.compression_knee + (c - s.compression_knee) * s.compression_ratio;
     c = std::round(c);

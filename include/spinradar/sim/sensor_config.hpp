@@ -18,6 +18,7 @@
   X(double, noise_floor_db, 8.0, 0.0, 100.0, "dB", "Mean receiver noise power (speckle, exponential)") \
   X(double, range_gain_db_per_decade, 30.0, 0.0, 60.0, "dB/dec", "Range gain (STC) compensating spreading loss") \
   X(double, power_scale, 1.0, 0.1, 10.0, "count/dB", "Output counts per dB (Navtech: about 1)") \
+  X(int, native_codes, 1, 0, 1, "", "1 = native Navtech code set (integer amplitude, then dB: 0, 6, 9, 12, ...); 0 = rescaled dB, every code (RADIATE images)") \
   X(double, saturation, 255.0, 1.0, 255.0, "count", "Largest output value") \
   X(double, min_range, 0.5, 0.0, 50.0, "m", "Returns closer than this are not rendered") \
   X(double, radar_constant_db, 103.0, 0.0, 300.0, "dB", "Received power of a 0 dBsm point at 1 m before range gain") \
