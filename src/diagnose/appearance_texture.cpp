@@ -109,6 +109,8 @@ AppearanceFinding fitTextureLength(const std::vector<PolarScan>& real, SensorCon
   const TextureFigure m = simAt(base);
   const double gap = r.value - m.value, se = differenceSe(r, m);
   const bool identifiable = cur.noise_texture_db > 0;
+  // Named when z >= z_min and practically large: the length by 40 % or more and the
+  // correlation by 0.02 or more (a rescaled recording moved it by 0.009: 8 -> 6 bins).
   const bool sig = identifiable && std::isfinite(gap) && se > 0 && std::abs(gap) / se >= opt.z_min;
   double value = base, sd = 0;
   if (sig) {
@@ -135,7 +137,9 @@ AppearanceFinding fitTextureLength(const std::vector<PolarScan>& real, SensorCon
   }
   AppearanceFinding f = makeFinding("noise texture correlation", "noise_texture_bins", "bins",
                                     base, value, sd, base > 0 ? std::abs(value / base - 1) : 0,
-                                    "relative", std::abs(value / base - 1) >= 0.25, opt.z_min);
+                                    "relative",
+                                    std::abs(value / base - 1) >= 0.4 && std::abs(gap) >= 0.02,
+                                    opt.z_min);
   if (!identifiable) f.verdict = "not identifiable", f.named = false;
   else if (!sig) f.verdict = "not significant", f.named = false;
   f.gap_before = gap;

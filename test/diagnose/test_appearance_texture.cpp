@@ -1,6 +1,7 @@
-// Noise texture correlation of the appearance stage with known truth: a recording whose noise
-// texture is correlated over 2 bins instead of 8 (RADIATE-like) gives the length back within
-// 10 %; the base model itself names nothing.
+// Texture and quantisation of the appearance stage with known truth: a recording whose noise
+// texture is correlated over 2 or 4 bins instead of 8 gives the length back within 10 %; a
+// recording rescaled from dB (every code, RADIATE's images) at 1.5 counts per dB is named
+// (native_codes 0) and its counts per dB come back within 10 %; the base model names nothing.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -81,6 +82,23 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"texture_length_half", "noise_texture_bins", 4.0, 0.4,
              [](sim::SensorConfig& s) { s.noise_texture_bins = 4.0; }}),
     [](const ::testing::TestParamInfo<Case>& i) { return std::string(i.param.name); });
+
+TEST(CodeSet, RescaledCountsNamedAndCountsPerDbFitted) {
+  sim::SensorConfig truth = baseSensor();
+  truth.native_codes = 0;
+  truth.power_scale = 1.5;
+  const auto rec = renderReference(truth, {}, quick(), 4242);
+  const AppearanceReport rep = diagnoseAppearance(rec, baseSensor(), {}, quick());
+  if (std::getenv("SPINRADAR_TEST_VERBOSE")) std::cerr << rep.summaryMarkdown();
+  const AppearanceFinding* hit = nullptr;
+  for (const auto& f : rep.findings)
+    if (f.parameter == "native_codes") hit = &f;
+  ASSERT_NE(hit, nullptr);
+  EXPECT_TRUE(hit->named) << hit->verdict;
+  EXPECT_EQ(rep.fitted.native_codes, 0);
+  EXPECT_NEAR(rep.fitted.power_scale, 1.5, 0.15);
+  EXPECT_EQ(rep.base.native_codes, 1);
+}
 
 }  // namespace
 }  // namespace spinradar::diagnose
