@@ -154,14 +154,15 @@ AppearanceFinding fitTextureLength(const std::vector<PolarScan>& real, SensorCon
 
 namespace {
 
-// Std of the counts at or below the median at 10-100 m (the noise side of the distribution).
-double lowerSpread(const std::vector<PolarScan>& scans) {
+// Std of the counts at or below the median at 10-100 m (the noise side of the distribution);
+// quarter >= 0: only the rows of that quarter of each scan.
+double lowerSpread(const std::vector<PolarScan>& scans, int quarter = -1) {
   std::array<double, 256> h{};
   for (const PolarScan& s : scans) {
     const int b0 = std::clamp(int(std::ceil(s.binOfRange(10.0))), 0, s.bins - 1);
     const int b1 = std::clamp(int(std::floor(s.binOfRange(100.0))), b0, s.bins - 1);
     for (int a = 0; a < s.azimuths; ++a)
-      if (s.valid.empty() || s.valid[a])
+      if ((s.valid.empty() || s.valid[a]) && (quarter < 0 || a * 4 / s.azimuths == quarter))
         for (int b = b0; b <= b1; ++b) h[s.row(a)[b]] += 1;
   }
   double n = 0;
@@ -174,6 +175,19 @@ double lowerSpread(const std::vector<PolarScan>& scans) {
   if (taken < 2) return NAN;
   const double mu = s1 / taken;
   return std::sqrt(std::max(s2 / taken - mu * mu, 0.0));
+}
+
+// Relative standard error of lowerSpread from its replicates (the quarters of every scan).
+double lowerSpreadRelSe(const std::vector<PolarScan>& scans) {
+  std::vector<double> v;
+  for (const PolarScan& s : scans)
+    for (int q = 0; q < 4; ++q) {
+      const double x = lowerSpread({s}, q);
+      if (std::isfinite(x)) v.push_back(x);
+    }
+  double mu = 0;
+  for (double x : v) mu += x;
+  return v.size() >= 2 && mu > 0 ? standardError(v) / (mu / double(v.size())) : 0;
 }
 
 }  // namespace
@@ -203,13 +217,17 @@ AppearanceFinding fitCodeSet(const std::vector<PolarScan>& real, const Appearanc
   // side of the counts, recording over the model at 1 count per dB (levels do not move it while
   // the floor is clear of zero). Before the catalogue fit, so that peak widths measured in counts
   // compare like with like.
-  const double sr = lowerSpread(real), sm = lowerSpread(renderReference(cur, phys, opt, opt.seed));
+  const std::vector<PolarScan> model_scans = renderReference(cur, phys, opt, opt.seed);
+  const double sr = lowerSpread(real), sm = lowerSpread(model_scans);
   if (std::isfinite(sr) && std::isfinite(sm) && sm > 0) {
     cur.power_scale = std::clamp(cur.power_scale * sr / sm, 0.5, 3.0);
+    // Uncertainty: the spreads' scatter over the scan quarters (recording and model).
+    const double sd = cur.power_scale * std::hypot(lowerSpreadRelSe(real), lowerSpreadRelSe(model_scans));
     notes.push_back("Rescaled counts (every code among 1-30): native_codes 0; counts per dB from "
                     "the spread of the noise side, " + std::to_string(sr) + " against " +
                     std::to_string(sm) + " at 1 count/dB: power_scale " +
-                    std::to_string(cur.power_scale) + " (refined by the range curves).");
+                    std::to_string(cur.power_scale) + " +- " + std::to_string(sd) +
+                    " (start of the range curves, which refine it).");
   }
   return f;
 }
