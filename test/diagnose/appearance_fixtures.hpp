@@ -4,6 +4,8 @@
 #include "spinradar/diagnose/appearance.hpp"
 #include "spinradar/sim/sensor_config.hpp"
 
+#include <string>
+
 namespace spinradar::diagnose::testing {
 
 /// 2300 bins x 0.0438 m = 100 m: all four bands (2.5-10, 10-25, 25-50, 50-100 m).
@@ -17,6 +19,28 @@ inline sim::SensorConfig hundredMetreSensor() {
 inline AppearanceOptions quickAppearanceOptions() {
   AppearanceOptions o;
   o.scans = 3;
+  return o;
+}
+
+/// "parameter=value " for every named finding of the report (empty: nothing named).
+inline std::string namedFindings(const AppearanceReport& rep) {
+  std::string named;
+  for (const auto& f : rep.findings)
+    if (f.named) named += f.parameter + "=" + std::to_string(f.value) + " ";
+  return named;
+}
+
+/// The catalogue stage alone, short: realism, clutter, near STC, curves and hold-out are
+/// tested elsewhere (test_appearance_bands.cpp).
+inline AppearanceOptions catalogueOnlyOptions() {
+  AppearanceOptions o = quickAppearanceOptions();
+  o.iterations = 2;
+  o.realism = false;
+  o.fit_clutter = false;
+  o.fit_near_stc = false;
+  o.relinearise = false;
+  o.holdout = false;
+  o.curve_iterations = 0;
   return o;
 }
 

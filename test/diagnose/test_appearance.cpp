@@ -16,18 +16,7 @@ namespace {
 
 sim::SensorConfig baseSensor() { return testing::hundredMetreSensor(); }
 
-// The catalogue stage alone: the realism, curve and hold-out steps are tested elsewhere.
-AppearanceOptions quickOptions() {
-  AppearanceOptions o = testing::quickAppearanceOptions();
-  o.iterations = 2;
-  o.realism = false;
-  o.fit_clutter = false;
-  o.fit_near_stc = false;
-  o.relinearise = false;
-  o.holdout = false;
-  o.curve_iterations = 0;
-  return o;
-}
+AppearanceOptions quickOptions() { return testing::catalogueOnlyOptions(); }
 
 struct Case {
   const char* name;
@@ -53,9 +42,7 @@ TEST_P(Concealed, NamedFirstAndFitted) {
   const auto rec = renderReference(truth, phys, quickOptions(), 4242);  // not the fit's seed
   const AppearanceReport rep = diagnoseAppearance(rec, baseSensor(), {}, quickOptions());
   if (std::getenv("SPINRADAR_TEST_VERBOSE")) std::cerr << rep.summaryMarkdown();
-  std::string named;
-  for (const auto& f : rep.findings)
-    if (f.named) named += f.parameter + "=" + std::to_string(f.value) + " ";
+  const std::string named = testing::namedFindings(rep);
   if (std::string(c.parameter).empty()) {
     EXPECT_TRUE(named.empty()) << c.name << ": named " << named;
     return;

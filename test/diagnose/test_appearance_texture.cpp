@@ -26,19 +26,7 @@ sim::SensorConfig baseSensor() {
   return s;
 }
 
-// The catalogue stage short (its parameters are tested in test_appearance.cpp), no realism,
-// curves or hold-out.
-AppearanceOptions quick() {
-  AppearanceOptions o = testing::quickAppearanceOptions();
-  o.iterations = 2;
-  o.realism = false;
-  o.fit_clutter = false;
-  o.fit_near_stc = false;
-  o.relinearise = false;
-  o.holdout = false;
-  o.curve_iterations = 0;
-  return o;
-}
+AppearanceOptions quick() { return testing::catalogueOnlyOptions(); }
 
 struct Case {
   const char* name;
@@ -56,9 +44,7 @@ TEST_P(TextureLength, FittedFromTheRecording) {
   const auto rec = renderReference(truth, {}, quick(), 4242);  // not the fit's seed
   const AppearanceReport rep = diagnoseAppearance(rec, baseSensor(), {}, quick());
   if (std::getenv("SPINRADAR_TEST_VERBOSE")) std::cerr << rep.summaryMarkdown();
-  std::string named;
-  for (const auto& f : rep.findings)
-    if (f.named) named += f.parameter + "=" + std::to_string(f.value) + " ";
+  const std::string named = testing::namedFindings(rep);
   if (std::string(c.parameter).empty()) {
     EXPECT_TRUE(named.empty()) << c.name << ": named " << named;
     return;
