@@ -105,6 +105,8 @@ class KeyframeTracker {
   /// keyframe turned by 15-30 deg at turn entry or exit), keypoints are paired with the
   /// nearest keyframe point within this distance of the predicted position instead.
   static constexpr double kProximityGate = 1.5;
+  /// m, nearest-point re-association after a descriptor registration (keyframe_tracker.cpp)
+  static constexpr double kReassociateGate = 0.3;
   static constexpr double kProximityMinAngle = 0.15;  ///< rad, keyframe-to-scan yaw for it
   static constexpr double kInlierRatio = 0.5;  ///< new keyframe below this x first count
   static constexpr double kPredictionGate = 2.0;  ///< m, first gate around the prediction
@@ -166,7 +168,7 @@ class KeyframeTracker {
   std::vector<char> in_;
   /// Fills the match arrays by proximity to the prediction (see kProximityGate).
   void associateByProximity(const FeatureFrame& cur, const Eigen::Matrix3d& T_pred,
-                            const Eigen::Vector3d& xi, double c);
+                            const Eigen::Vector3d& xi, double c, double gate);
   void addMatch(const Eigen::Vector2d& key_pt, const Keypoint& k, double tau);
   double row_step_ = 0.0;  ///< rowQuantization() of the scan being tracked
 };
