@@ -1,5 +1,7 @@
 #include "spinradar/estimation/refined_estimator.hpp"
 
+#include "cauchy_weights.hpp"
+
 #include <cmath>
 
 #include <Eigen/Cholesky>
@@ -45,7 +47,14 @@ bool RefinedEstimator::optimise(Eigen::Vector3d& varpi, Eigen::Matrix3d& cov,
   }
   double wr2 = 0.0, wsum = 0.0;
   const int iterations = std::max(3, config_.gn_iterations);
+  r2_.assign(n, 0.0);
   for (int it = 0; it < iterations; ++it) {
+    // Cauchy weights (robust_loss) from the previous iterate's residuals.
+    if (config_.robust_loss && it >= 1) {
+      r2_scratch_.assign(r2_.begin(), r2_.end());
+      const double inv_scale = cauchyInverseScale(r2_scratch_);
+      for (int m = 0; m < n; ++m) w_[m] = cauchyWeight(r2_[m], inv_scale);
+    }
     A = P_inv;
     Eigen::Vector3d b = P_inv * (prior - varpi);
     wr2 = wsum = 0.0;
@@ -67,7 +76,8 @@ bool RefinedEstimator::optimise(Eigen::Vector3d& varpi, Eigen::Matrix3d& cov,
           cartesianCovariance(p2, sr, sa) + C * cartesianCovariance(p1, sr, sa) * C.transpose();
       const Eigen::Matrix2d Si = S.inverse();
       const double r2 = e.dot(Si * e);
-      const double w = w_[m];  // 1: every gated match (see the header)
+      r2_[m] = r2;
+      const double w = w_[m];  // 1 without robust_loss (see the header)
       const Eigen::Matrix<double, 3, 2> GtW = w * G.transpose() * Si;
       A.noalias() += GtW * G;
       b.noalias() += GtW * e;
@@ -84,8 +94,7 @@ bool RefinedEstimator::optimise(Eigen::Vector3d& varpi, Eigen::Matrix3d& cov,
   const double dof = std::max(1.0, 2.0 * wsum - 3.0);
   chi2_per_dof = wr2 / dof;
   cov = A.inverse() * std::max(1.0, chi2_per_dof);
-  used = 0;
-  for (double w : w_) used += w > 0.5;
+  used = n;
   return varpi.allFinite() && cov.allFinite();
 }
 

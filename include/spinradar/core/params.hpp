@@ -35,6 +35,7 @@
   X(double, beta, 0.049, 0.0, 1.0, "s", "Doppler coefficient beta = f_t / (df/dt)") \
   X(double, range_sigma, 0.0438, 0.001, 1.0, "m", "Range noise std for Cartesian covariance weighting") \
   X(double, azimuth_sigma, 0.0045, 0.0001, 0.1, "rad", "Azimuth noise std for Cartesian covariance weighting") \
+  X(bool, robust_loss, true, 0, 1, "", "Cauchy loss, scaled by the median residual, in the refit of refined (the pair estimate of keyframe and surface); false: every gated match weighted 1. mc and mc_doppler stay the paper's least squares") \
   X(std::string, azimuth_times, "stamps", 0, 0, "", "Keypoint times: stamps (each row's recorded stamp) or uniform (a line fitted to the scan's row stamps: for stamps that are packet arrival times, as in Oxford and MulRan)")
 // clang-format on
 
