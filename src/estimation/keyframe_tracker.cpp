@@ -431,10 +431,15 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     J.leftCols<3>().setIdentity();
     J.rightCols<3>() = -c * se2::adjoint(T_jk);
     const Eigen::Matrix3d Lk = se2::leftPerturbationToXyYaw(T_mk);
-    const Eigen::Matrix3d C_mk = Lk * J * Cd * J.transpose() * Lk.transpose();
+    // The keyframe map's own error stays: its points were moved to M_j with its velocity
+    // estimate, by up to c_j, so a velocity error dxi_j moves them by up to c_j dxi_j (as
+    // in C_rel). Without it a keyframe taken at a failed turn scan (tight_turns layout 1:
+    // 19 deg off, key_xi_cov_ holding the yaw-rate step) left the chain at NEES 76.
+    const Eigen::Matrix3d Ckey = key_c_ * key_c_ * key_xi_cov_;
+    const Eigen::Matrix3d C_mk = Lk * (J * Cd * J.transpose() + Ckey) * Lk.transpose();
     Eigen::Matrix3d T_unused;
     se2::compoundXyYaw(M_j, P_jm_, T_mk, C_mk, T_unused, P);
-    const Eigen::Matrix3d C_jk_acc = Lm * Cd.topLeftCorner<3, 3>() * Lm.transpose();
+    const Eigen::Matrix3d C_jk_acc = Lm * (Cd.topLeftCorner<3, 3>() + Ckey) * Lm.transpose();
     se2::compoundXyYaw(M_j, P_jm_, T_jk, C_jk_acc, T_unused, P_m_next);
   }
   pair.T_12 = se2::inverse(T_w_prev) * T_w;
