@@ -169,6 +169,8 @@ class KeyframeTracker {
   /// [x, y, yaw] covariance of the keyframe's mid-scan world pose T_wj_ exp(key_c_ key_xi_):
   /// the accumulated pose's chain (see track()).
   Eigen::Matrix3d P_jm_ = Eigen::Matrix3d::Zero();
+  /// |acceleration| [ax, ay, alpha] over the scan period before this scan / the keyframe.
+  Eigen::Vector3d accel_ = Eigen::Vector3d::Zero(), key_accel_ = Eigen::Vector3d::Zero();
   // Per-scan buffers (structure of arrays over the keyframe matches).
   std::vector<Match> matches_;
   std::vector<Keypoint> tmp_kps_;
