@@ -30,6 +30,7 @@
 // scan start. Mean NEES of the published pose relative to the keyframe, city route with
 // full physics, layouts 0-3: 3.31 / 3.17 / 2.42 / 3.83 (95 % bound covers 94.1-95.5 %;
 // 5.2-6.1 and 84-89 % with the scan-start reference).
+// The accumulated pose's covariance (issue 19) is chained apart, at mid-scan: see track().
 // Mid-scan reference (turn entry and exit): the registration measures the pose at the mean
 // time of the scan's points well, the yaw rate within a scan only weakly (it trades against
 // the yaw). So poses are solved, chained and kept for keyframes (their maps undistorted to
@@ -132,12 +133,15 @@ class KeyframeTracker {
                     const Eigen::Matrix3d& T_w, const Eigen::Matrix3d& P);
   /// Gauss-Newton; T and xi in/out. False when too few inliers or singular.
   /// cov: the 6x6 covariance that chains into the next prior (tuned for drift); cov_pub:
-  /// the published one (honest, see the .cpp). Cxi_honest: the velocity prior's covariance
-  /// with its real lag, for cov_pub.
+  /// the published one relative to the keyframe (honest, see the .cpp); cov_acc: the one
+  /// the accumulated pose chains (the error of the estimate actually made, with the motion
+  /// model's errors considered, see the .cpp). Cxi_honest: the velocity prior's covariance
+  /// with its real lag, for cov_pub and cov_acc.
   bool solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3d& C_prior,
              const Eigen::Vector3d& xi_prior, const Eigen::Matrix3d& Cxi_prior,
              const Eigen::Matrix3d& Cxi_honest, Eigen::Matrix3d& T, Eigen::Vector3d& xi,
-             Eigen::Matrix<double, 6, 6>& cov, Eigen::Matrix<double, 6, 6>& cov_pub);
+             Eigen::Matrix<double, 6, 6>& cov, Eigen::Matrix<double, 6, 6>& cov_pub,
+             Eigen::Matrix<double, 6, 6>& cov_acc);
 
   EstimatorConfig config_;
   bool has_key_ = false;
@@ -156,20 +160,27 @@ class KeyframeTracker {
   Eigen::Matrix3d rel_T_ = Eigen::Matrix3d::Identity(), rel_C_ = Eigen::Matrix3d::Zero();  ///< inliers of the first registration to this keyframe (0 = none yet)
   // Keyframe: points at its reference time in its frame, descriptors, pose.
   std::vector<Eigen::Vector2d> key_pts_;
+  std::vector<double> key_tau_;  ///< each keyframe point's time (s) after the keyframe's reference
   cv::Mat key_desc_storage_, key_desc_;
   /// Keyframe: scan-start world pose and its covariance (published).
   Eigen::Matrix3d T_wj_ = Eigen::Matrix3d::Identity(), P_j_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d T_jprev_ = Eigen::Matrix3d::Identity(), C_jprev_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d C_jprev_pub_ = Eigen::Matrix3d::Zero();  ///< published covariance of T_jprev_
+  /// [x, y, yaw] covariance of the keyframe's mid-scan world pose T_wj_ exp(key_c_ key_xi_):
+  /// the accumulated pose's chain (see track()).
+  Eigen::Matrix3d P_jm_ = Eigen::Matrix3d::Zero();
+  /// |acceleration| [ax, ay, alpha] over the scan period before this scan / the keyframe.
+  Eigen::Vector3d accel_ = Eigen::Vector3d::Zero(), key_accel_ = Eigen::Vector3d::Zero();
   // Per-scan buffers (structure of arrays over the keyframe matches).
   std::vector<Match> matches_;
   std::vector<Keypoint> tmp_kps_;
   std::vector<double> qx_, qy_, px_, py_, ux_, uy_, tau_;
+  std::vector<double> key_tau_m_;  ///< the matched keyframe point's key_tau_
   std::vector<char> in_;
   /// Fills the match arrays by proximity to the prediction (see kProximityGate).
   void associateByProximity(const FeatureFrame& cur, const Eigen::Matrix3d& T_pred,
                             const Eigen::Vector3d& xi, double c, double gate);
-  void addMatch(const Eigen::Vector2d& key_pt, const Keypoint& k, double tau);
+  void addMatch(size_t key_index, const Keypoint& k, double tau);
   double row_step_ = 0.0;  ///< rowQuantization() of the scan being tracked
 };
 

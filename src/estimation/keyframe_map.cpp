@@ -1,0 +1,123 @@
+// The keyframe map of KeyframeTracker: taking a scan as the keyframe (its points
+// Doppler-corrected and moved to its mid-scan reference) and pairing a scan's keypoints with
+// it (descriptor matches are filled in track(); proximity to a prediction here). Split from
+// keyframe_tracker.cpp (the registration and the covariances) to keep files small.
+#include <algorithm>
+#include <cmath>
+
+#include "spinradar/core/lie.hpp"
+#include "spinradar/estimation/doppler.hpp"
+#include "spinradar/estimation/keyframe_tracker.hpp"
+#include "spinradar/estimation/undistort.hpp"
+
+namespace spinradar {
+
+namespace {
+
+double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+
+}  // namespace
+
+double KeyframeTracker::rowQuantization(const FeatureFrame& f) {
+  int same_row = 0, same_angle = 0;
+  double step = 0.0;
+  const std::vector<Keypoint>& k = f.keypoints;
+  for (size_t i = 1; i < k.size(); ++i) {
+    if (k[i].azimuth_index == k[i - 1].azimuth_index) {
+      ++same_row;
+      same_angle += k[i].azimuth == k[i - 1].azimuth;
+    } else if (step == 0.0 && k[i].azimuth_index == k[i - 1].azimuth_index + 1) {
+      step = std::abs(wrapAngle(k[i].azimuth - k[i - 1].azimuth));
+    }
+  }
+  return same_row >= 20 && same_angle >= 0.9 * same_row ? step : 0.0;
+}
+
+void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d& xi, double c,
+                                   const Eigen::Matrix3d& T_w, const Eigen::Matrix3d& P) {
+  // The keyframe's points as a static map: Doppler-corrected and moved to its reference
+  // time with its own velocity. Headroom so that later keyframes rarely reallocate.
+  const size_t n = f.keypoints.size();
+  if (tmp_kps_.capacity() < n) tmp_kps_.reserve(n + n / 2);
+  if (key_pts_.capacity() < n) key_pts_.reserve(n + n / 2);
+  if (key_tau_.capacity() < n) key_tau_.reserve(n + n / 2);
+  if (matches_.capacity() < n) {  // at most one match per keyframe row
+    const size_t c = n + n / 2;
+    matches_.reserve(c);
+    for (auto* v : {&qx_, &qy_, &px_, &py_, &ux_, &uy_, &tau_, &key_tau_m_}) v->reserve(c);
+    in_.reserve(c);
+  }
+  dopplerCorrect(f.keypoints, xi, config_.beta, tmp_kps_);
+  const int64_t ref_ns = f.stamp_ns + static_cast<int64_t>(std::llround(1e9 * c));
+  undistortPoints(tmp_kps_, xi, ref_ns, key_pts_);
+  key_tau_.resize(n);
+  for (size_t i = 0; i < n; ++i)
+    key_tau_[i] = 1e-9 * static_cast<double>(f.keypoints[i].stamp_ns - ref_ns);
+  const cv::Mat& d = f.descriptors;
+  if (d.empty()) {
+    key_desc_ = cv::Mat();
+  } else {
+    if (key_desc_storage_.rows < d.rows || key_desc_storage_.cols != d.cols ||
+        key_desc_storage_.type() != d.type())
+      key_desc_storage_.create(std::max(d.rows + d.rows / 2, 64), d.cols, d.type());
+    key_desc_ = key_desc_storage_.rowRange(0, d.rows);
+    d.copyTo(key_desc_);
+  }
+  T_wj_ = T_w;
+  P_j_ = P;
+  key_c_ = c;
+  key_xi_ = xi;
+  key_stamp_ = f.stamp_ns;
+  T_jprev_.setIdentity();
+  C_jprev_.setZero();
+  C_jprev_pub_.setZero();
+  key_inliers_ = 0;
+  has_key_ = true;
+  ++switches_;
+}
+
+void KeyframeTracker::addMatch(size_t key_index, const Keypoint& k, double tau) {
+  qx_.push_back(key_pts_[key_index].x());
+  qy_.push_back(key_pts_[key_index].y());
+  key_tau_m_.push_back(key_tau_[key_index]);
+  px_.push_back(k.x);
+  py_.push_back(k.y);
+  ux_.push_back(std::cos(k.azimuth));
+  uy_.push_back(-std::sin(k.azimuth));
+  tau_.push_back(tau);
+}
+
+void KeyframeTracker::associateByProximity(const FeatureFrame& cur, const Eigen::Matrix3d& T_pred,
+                                           const Eigen::Vector3d& xi, double c, double gate) {
+  qx_.clear(); qy_.clear(); px_.clear(); py_.clear(); ux_.clear(); uy_.clear(); tau_.clear();
+  key_tau_m_.clear();
+  const size_t n = cur.keypoints.size();
+  if (qx_.capacity() < n) {  // rare: a scan with more keypoints than the keyframe's headroom
+    for (auto* v : {&qx_, &qy_, &px_, &py_, &ux_, &uy_, &tau_, &key_tau_m_}) v->reserve(n + n / 2);
+    in_.reserve(n + n / 2);
+  }
+  const double gate2 = gate * gate;
+  const double beta = config_.beta;
+  for (const Keypoint& k : cur.keypoints) {
+    const double tau = 1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c;
+    const double ux = std::cos(k.azimuth), uy = -std::sin(k.azimuth);
+    const double d = beta * (ux * xi(0) + uy * xi(1));
+    const Eigen::Vector3d p(k.x + d * ux, k.y + d * uy, 1.0);
+    const Eigen::Vector2d qh = (T_pred * se2::exp(tau * xi) * p).head<2>();
+    // Brute force: this runs only on scans the descriptors could not register (a few %).
+    double best = gate2;
+    int best_j = -1;
+    for (size_t j = 0; j < key_pts_.size(); ++j) {
+      const double dx = key_pts_[j].x() - qh.x();
+      if (dx * dx >= best) continue;
+      const double dy = key_pts_[j].y() - qh.y();
+      if (dx * dx + dy * dy < best) {
+        best = dx * dx + dy * dy;
+        best_j = static_cast<int>(j);
+      }
+    }
+    if (best_j >= 0) addMatch(static_cast<size_t>(best_j), k, tau);
+  }
+}
+
+}  // namespace spinradar
