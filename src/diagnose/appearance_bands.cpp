@@ -80,14 +80,14 @@ void setParam(SensorConfig& s, int type, int j, double p) {
 const char* const kFigureNames[kPerBand] = {"mean", "q90", "cacfar", "cen2018", "floor"};
 
 // Scene-dependent figures weigh nothing: their rows of the residual and the Jacobian are zero.
-Eigen::VectorXd logFigures(const sim::RealismStats& st, bool with_floor) {
+Eigen::VectorXd logFigures(const sim::RealismStats& st, const AppearanceOptions& opt) {
   Eigen::VectorXd v(kRows);
   for (int k = 0; k < kBands; ++k) {
     v[kPerBand * k + 0] = std::log(1 + st.band_mean[k]);
     v[kPerBand * k + 1] = std::log(1 + st.band_q90[k]);
     v[kPerBand * k + 2] = std::log(1 + st.band_cacfar[k]);
-    v[kPerBand * k + 3] = std::log(1 + std::max(st.band_cen[k], 0.0));
-    v[kPerBand * k + 4] = with_floor ? std::log(1 + st.band_floor[k]) : 0.0;
+    v[kPerBand * k + 3] = opt.fit_cen2018 ? std::log(1 + std::max(st.band_cen[k], 0.0)) : 0.0;
+    v[kPerBand * k + 4] = opt.fit_band_floor ? std::log(1 + st.band_floor[k]) : 0.0;
     for (int i = 0; i < kPerBand; ++i)
       if (isSceneDependent(k, kFigureNames[i])) v[kPerBand * k + i] = 0;
   }
@@ -172,10 +172,10 @@ SensorConfig fitRangeCurves(const sim::RealismStats& real, const SensorConfig& s
                             std::vector<std::string>* log) {
   SensorConfig cur = start;
   if (cur.clutter_density <= 0) cur.clutter_density = 0.05;
-  const Eigen::VectorXd target = logFigures(real, opt.fit_band_floor);
+  const Eigen::VectorXd target = logFigures(real, opt);
   auto eval = [&](const SensorConfig& s, Eigen::VectorXd& f) {
     try {
-      f = logFigures(realismOf(s, physics, opt, opt.seed, ""), opt.fit_band_floor);
+      f = logFigures(realismOf(s, physics, opt, opt.seed, ""), opt);
       return true;
     } catch (const std::invalid_argument&) {  // e.g. too many clutter scatterers
       return false;

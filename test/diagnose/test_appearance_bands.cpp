@@ -172,5 +172,23 @@ TEST(AppearanceBands, ConcealedFarNoiseFloorFitted) {
   }
 }
 
+// Left out of the fit (fit_cen2018 off), the Cen2018 counts cannot move it: a recording with
+// any Cen2018 figures gives the same curves.
+TEST(AppearanceBands, Cen2018LeftOutCannotDriveTheFit) {
+  sim::SensorConfig truth = baseSensor();
+  truth.stc_curve_db_16m = 4.0;
+  const auto real = sim::computeRealism(renderReference(truth, {}, quick(), 4243), "recording");
+  AppearanceOptions opt = quick();
+  opt.curve_iterations = 2;
+  opt.fit_band_floor = true;
+  opt.fit_cen2018 = false;
+  auto fewer = real;
+  for (double& c : fewer.band_cen) c *= 0.3;
+  const sim::SensorConfig a = fitRangeCurves(real, baseSensor(), {}, opt);
+  const sim::SensorConfig b = fitRangeCurves(fewer, baseSensor(), {}, opt);
+  EXPECT_NE(a.toJson(), baseSensor().toJson());  // the fit moved
+  EXPECT_EQ(a.toJson(), b.toJson());
+}
+
 }  // namespace
 }  // namespace spinradar::diagnose

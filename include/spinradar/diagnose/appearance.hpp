@@ -94,6 +94,11 @@ struct AppearanceOptions {
   /// default fit 0.0) but the reference city scene then cannot give Oxford's Cen2018 counts
   /// (docs/diagnose.md, "Oxford's Cen2018 counts").
   bool fit_band_floor = false;
+  /// Let the Cen2018 keypoints per band drive the range-curve fit (they are still measured and
+  /// in every gap figure either way). Off = they weigh nothing: with the floors fitted, the
+  /// reference city scene cannot give Oxford's counts (a third at 10-25 m; scene content,
+  /// docs/diagnose_cen2018.md) and they would pull every other figure off.
+  bool fit_cen2018 = true;
   /// Fit on part of the recording and check on the rest (splitHoldout).
   bool holdout = true;
 };
