@@ -124,6 +124,8 @@ nlohmann::json AppearanceReport::toJson() const {
     b["q90"] = std::vector<double>(s.band_q90, s.band_q90 + 4);
     b["cacfar"] = std::vector<double>(s.band_cacfar, s.band_cacfar + 4);
     b["cen2018"] = std::vector<double>(s.band_cen, s.band_cen + 4);
+    // Not a gap figure: the noise side, which tells receiver noise from weak clutter.
+    b["floor"] = std::vector<double>(s.band_floor, s.band_floor + 4);
     return b;
   };
   if (!realism_real.name.empty()) {

@@ -146,6 +146,14 @@ RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::stri
         break;
       }
     }
+    // Lower half of the counts, the last code partly: same definition as the appearance floor.
+    double lo = 0, taken = 0;
+    for (int v = 0; v < 256 && n > 0 && taken < 0.5 * n; ++v) {
+      const double t = std::min(band_hist[k][v], 0.5 * n - taken);
+      lo += t * v;
+      taken += t;
+    }
+    if (taken > 0) st.band_floor[k] = lo / taken;
     st.band_cacfar[k] = cacfar[k] / ns;
     st.cacfar += cacfar[k] / ns;
     if (o.detect) st.band_cen[k] = cen_band[k] / ns;

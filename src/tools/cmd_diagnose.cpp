@@ -36,6 +36,8 @@ struct DiagnoseArgs {
   int appearance_scans = 4;
   int curve_iterations = 16;
   bool no_holdout = false;
+  bool fit_floor = false;
+  bool no_cen2018_fit = false;
 };
 
 /// The appearance stage (no world or trajectory needed): findings, fitted sensor file, plots
@@ -54,6 +56,8 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   opt.scans = a.appearance_scans;
   opt.curve_iterations = a.curve_iterations;
   opt.holdout = !a.no_holdout;
+  opt.fit_band_floor = a.fit_floor;
+  opt.fit_cen2018 = !a.no_cen2018_fit;
   const auto rep = diagnose::diagnoseAppearance(scans, s, physics, opt);
   const std::string dir = (fs::path(a.out) / "appearance").string();
   diagnose::writeAppearanceReport(rep, scans, opt, dir);
@@ -284,6 +288,12 @@ SPINRADAR_COMMAND(
       app.add_flag("--appearance-no-holdout", a->no_holdout,
                    "Fit the appearance on the whole recording (default: fit on the first half of "
                    "the scans, or quarters 0 and 2 of a single scan, check on the rest)");
+      app.add_flag("--appearance-fit-floor", a->fit_floor,
+                   "Also fit each band's noise floor (lower half of the counts) in the per-band "
+                   "calibration: tells receiver noise from weak clutter (docs/diagnose.md)");
+      app.add_flag("--appearance-no-cen2018-fit", a->no_cen2018_fit,
+                   "Leave the Cen2018 keypoints out of the per-band calibration (still reported): "
+                   "with --appearance-fit-floor on Oxford they measure the scene (docs/diagnose_cen2018.md)");
       app.add_option("--appearance-scans", a->appearance_scans,
                      "Re-simulated scans per evaluation in the appearance fit")
           ->capture_default_str();

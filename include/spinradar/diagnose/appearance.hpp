@@ -88,6 +88,17 @@ struct AppearanceOptions {
   /// Per-band calibration after the global fit: range curves fitted on the per-band realism
   /// figures (fitRangeCurves); 0 iterations = off.
   int curve_iterations = 24;
+  /// Add each band's floor (mean of the lower half of the counts) to the range-curve fit's
+  /// figures, so that receiver noise and dense weak clutter are told apart. Off by default: on
+  /// the Oxford sample it gives the recording's noise floor back (50-100 m: 2.1 counts, the
+  /// default fit 0.0) but the reference city scene then cannot give Oxford's Cen2018 counts
+  /// (docs/diagnose.md, "Oxford's Cen2018 counts").
+  bool fit_band_floor = false;
+  /// Let the Cen2018 keypoints per band drive the range-curve fit (they are still measured and
+  /// in every gap figure either way). Off = they weigh nothing: with the floors fitted, the
+  /// reference city scene cannot give Oxford's counts (a third at 10-25 m; scene content,
+  /// docs/diagnose_cen2018.md) and they would pull every other figure off.
+  bool fit_cen2018 = true;
   /// Fit on part of the recording and check on the rest (splitHoldout).
   bool holdout = true;
 };

@@ -35,6 +35,9 @@ struct RealismStats {
   double band_q90[4] = {0, 0, 0, 0};
   double band_cacfar[4] = {0, 0, 0, 0};
   double band_cen[4] = {-1, -1, -1, -1};
+  /// Per range band: mean of the lower half of the counts (the receiver noise side; the
+  /// appearance stage's range-curve fit needs it to tell noise from clutter, not a realism gap).
+  double band_floor[4] = {0, 0, 0, 0};
   double cacfar = 0;              ///< plain CA-CFAR cells per scan, all bands
 };
 
