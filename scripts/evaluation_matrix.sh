@@ -38,14 +38,16 @@ bin="$(spinradar_cli_path "$root")"
 mkdir -p "$out"
 
 # --- rows: label = odometry options -------------------------------------------------------
+# Every row names its front end: azimuth_peaks is on by default since 2026-11-27, and the rows
+# without "+peaks" are the paper's front end (one keypoint per row at the row angle).
 declare -A row_args=(
-  [rigid]="--estimator rigid"
-  [mc]="--estimator mc"
-  [mc_doppler]="--estimator mc_doppler"
-  [refined]="--estimator refined"
-  [keyframe]="--estimator keyframe"
+  [rigid]="--estimator rigid --azimuth_peaks false"
+  [mc]="--estimator mc --azimuth_peaks false"
+  [mc_doppler]="--estimator mc_doppler --azimuth_peaks false"
+  [refined]="--estimator refined --azimuth_peaks false"
+  [keyframe]="--estimator keyframe --azimuth_peaks false"
   [keyframe+peaks]="--estimator keyframe --azimuth_peaks true"
-  [surface]="--estimator surface"
+  [surface]="--estimator surface --azimuth_peaks false"
   [surface+peaks]="--estimator surface --azimuth_peaks true"
 )
 all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks surface surface+peaks)

@@ -120,6 +120,7 @@ RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::stri
       dc.min_range = o.min_range;
       dc.max_range = o.max_range;
       dc.detector = "cen2018";
+      dc.azimuth_peaks = false;  // the figures are the paper's detectors: keypoints per row
       Detector d(dc);
       d.detect(s, kps);
       det_cen += kps.size() * per_rotation;

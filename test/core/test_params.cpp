@@ -34,17 +34,18 @@ TEST(Params, VisitSeesEveryParameterOnce) {
   EXPECT_GT(n, 15);
 }
 
-TEST(Params, AzimuthPeaksIsADetectorParameterOffByDefault) {
-  // Off reproduces the paper's front end (one keypoint per azimuth row).
+TEST(Params, AzimuthPeaksIsADetectorParameterOnByDefault) {
+  // On by default (the evaluation matrix, README); off reproduces the paper's front end (one
+  // keypoint per azimuth row).
   PipelineConfig c;
-  EXPECT_FALSE(c.detector.azimuth_peaks);
+  EXPECT_TRUE(c.detector.azimuth_peaks);
   int seen = 0;
   c.detector.visit([&](const ParamMeta& m, auto& v) {
     if (std::string(m.name) != "azimuth_peaks") return;
     ++seen;
-    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, bool>) v = true;
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, bool>) v = false;
   });
   EXPECT_EQ(seen, 1);
-  EXPECT_TRUE(c.detector.azimuth_peaks);
+  EXPECT_FALSE(c.detector.azimuth_peaks);
   EXPECT_NO_THROW(c.validate());
 }

@@ -67,6 +67,7 @@ TEST_P(DetectorTest, FindsInjectedTargetsWithFewFalseAlarms) {
   const auto targets = someTargets();
   const PolarScan s = test::syntheticScan(targets);
   DetectorConfig c;
+  c.azimuth_peaks = false;  // the paper's Cen2018 / CFAR: keypoints per row
   c.detector = GetParam();
   Detector d(c);
   std::vector<Keypoint> kps;
@@ -83,6 +84,7 @@ TEST_P(DetectorTest, RespectsRangeLimitsOffsetAndValidFlags) {
   std::vector<Target> targets = {{0.3, 2.0, 40}, {1.0, 10.0, 40}, {2.0, 40.0, 40}, {3.0, 120.0, 40}};
   PolarScan s = test::syntheticScan(targets, 3);
   DetectorConfig c;
+  c.azimuth_peaks = false;  // the paper's Cen2018 / CFAR: keypoints per row
   c.detector = GetParam();
   c.min_range = 5.0;
   c.max_range = 100.0;
@@ -132,6 +134,7 @@ TEST(Detector, FlatAndEmptyRowsGiveNoKeypoints) {
   std::vector<Keypoint> kps;
   for (const char* det : {"cen2018", "cfar"}) {
     DetectorConfig c;
+    c.azimuth_peaks = false;  // the paper's Cen2018 / CFAR: keypoints per row
     c.detector = det;
     Detector d(c);
     d.detect(s, kps);
@@ -197,6 +200,7 @@ TEST(Detector, Cen2018AgreesWithBruteForceReference) {
   const PolarScan s = test::syntheticScan(targets, 11, 100, 2000);
   for (double zq : {1.0, 2.0, 3.0}) {
     DetectorConfig c;
+    c.azimuth_peaks = false;  // the paper's Cen2018 / CFAR: keypoints per row
     c.zq = zq;
     Detector d(c);
     std::vector<Keypoint> kps;
@@ -226,6 +230,7 @@ TEST(Detector, Cen2018CandidateBoundLosesNothing) {
     const PolarScan s = test::syntheticScan(targets, seed, 200, 3000);
     for (double zq : {0.5, 1.0, 2.0, 2.5, 3.0}) {
       DetectorConfig c;
+      c.azimuth_peaks = false;  // the paper's Cen2018 / CFAR: keypoints per row
       c.zq = zq;
       Detector fast(c), every(c);
       every.setScoreEveryBin(true);

@@ -144,10 +144,10 @@ TEST(KeypointTruth, SteadyTurnYawRateThroughTheFrontEnd) {
 
 TEST(KeypointTruth, AzimuthPeaksParameterFromTheCommandLineGivesSubRowAzimuths) {
   // A still sensor and point targets at known bearings a fraction of a row off the row angles
-  // (rows at a * 2 pi / 400). With `--azimuth-peaks 1` (CLI options -> PipelineConfig ->
+  // (rows at a * 2 pi / 400). With `--azimuth-peaks 1` (the default; CLI options -> PipelineConfig ->
   // FeatureExtractor, as `spinradar odometry` builds it) each target gives one keypoint within
   // +-2 rows, at its bearing within 0.1 row (measured <= 0.05), i.e. off the row angle. Without
-  // it (the default) each target gives keypoints on the 4 rows its beam covers, all exactly at
+  // it (`--azimuth-peaks 0`, the paper's front end) each target gives keypoints on the 4 rows its beam covers, all exactly at
   // row angles. Both detectors. (The sidelobes ~3 rows off are azimuthal peaks of their own and
   // not counted.)
   const double fracs[] = {0.3, -0.3, 0.4, -0.4, 0.25, -0.2};
@@ -170,7 +170,7 @@ TEST(KeypointTruth, AzimuthPeaksParameterFromTheCommandLineGivesSubRowAzimuths) 
       cli::PipelineOptions opts;
       opts.add(app);
       std::vector<std::string> args = {"--detector", detector};
-      if (peaks) args.insert(args.end(), {"--azimuth-peaks", "1"});
+      args.insert(args.end(), {"--azimuth-peaks", peaks ? "1" : "0"});
       std::reverse(args.begin(), args.end());  // CLI11 takes the arguments last-first
       app.parse(args);
       const PipelineConfig cfg = opts.resolve();

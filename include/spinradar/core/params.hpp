@@ -17,7 +17,7 @@
   X(double, min_range, 2.5, 0.0, 100.0, "m", "Ignore returns closer than this (vehicle, near-field leakage)") \
   X(double, max_range, 160.0, 1.0, 500.0, "m", "Ignore returns farther than this") \
   X(double, range_offset, 0.0, -5.0, 5.0, "m", "Added to every range (Boreas: -0.31)") \
-  X(bool, azimuth_peaks, false, 0, 1, "", "One keypoint per return at its azimuthal power peak, sub-row azimuth and time (false: one per row at the row angle, the paper's front end)")
+  X(bool, azimuth_peaks, true, 0, 1, "", "One keypoint per return at its azimuthal power peak, sub-row azimuth and time (false: one per row at the row angle, the paper's front end)")
 
 #define SPINRADAR_FEATURE_PARAMS(X) \
   X(double, cart_resolution, 0.2592, 0.01, 2.0, "m/px", "Cartesian image resolution") \
