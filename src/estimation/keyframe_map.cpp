@@ -50,6 +50,10 @@ void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d&
   dopplerCorrect(f.keypoints, xi, config_.beta, tmp_kps_);
   const int64_t ref_ns = f.stamp_ns + static_cast<int64_t>(std::llround(1e9 * c));
   undistortPoints(tmp_kps_, xi, ref_ns, key_pts_);
+  // Sorted by x for the proximity search (associateByProximity).
+  key_by_x_.resize(n);
+  for (size_t i = 0; i < n; ++i) key_by_x_[i] = {key_pts_[i].x(), static_cast<int>(i)};
+  std::sort(key_by_x_.begin(), key_by_x_.end());
   key_tau_.resize(n);
   for (size_t i = 0; i < n; ++i)
     key_tau_[i] = 1e-9 * static_cast<double>(f.keypoints[i].stamp_ns - ref_ns);
@@ -104,16 +108,17 @@ void KeyframeTracker::associateByProximity(const FeatureFrame& cur, const Eigen:
     const double d = beta * (ux * xi(0) + uy * xi(1));
     const Eigen::Vector3d p(k.x + d * ux, k.y + d * uy, 1.0);
     const Eigen::Vector2d qh = (T_pred * se2::exp(tau * xi) * p).head<2>();
-    // Brute force: this runs only on scans the descriptors could not register (a few %).
+    // Only the keyframe points within the gate in x (key_by_x_ is sorted by x).
     double best = gate2;
     int best_j = -1;
-    for (size_t j = 0; j < key_pts_.size(); ++j) {
-      const double dx = key_pts_[j].x() - qh.x();
-      if (dx * dx >= best) continue;
-      const double dy = key_pts_[j].y() - qh.y();
+    auto it = std::lower_bound(key_by_x_.begin(), key_by_x_.end(),
+                               std::make_pair(qh.x() - gate, -1));
+    for (; it != key_by_x_.end() && it->first <= qh.x() + gate; ++it) {
+      const Eigen::Vector2d& kp = key_pts_[static_cast<size_t>(it->second)];
+      const double dx = kp.x() - qh.x(), dy = kp.y() - qh.y();
       if (dx * dx + dy * dy < best) {
         best = dx * dx + dy * dy;
-        best_j = static_cast<int>(j);
+        best_j = it->second;
       }
     }
     if (best_j >= 0) addMatch(static_cast<size_t>(best_j), k, tau);

@@ -49,6 +49,7 @@
 // A new keyframe is taken when the current one is far (distance, angle), when the
 // registration keeps too few inliers, or when it fails (then the pose is the prior).
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -106,6 +107,10 @@ class KeyframeTracker {
   /// keyframe turned by 15-30 deg at turn entry or exit), keypoints are paired with the
   /// nearest keyframe point within this distance of the predicted position instead.
   static constexpr double kProximityGate = 1.5;
+  /// After a proximity registration: pair again under the solved pose within this gate (m)
+  /// and solve, at most this many times, until the pose settles (keyframe_tracker.cpp).
+  static constexpr double kProximityRegate = 0.6;
+  static constexpr int kProximityIterations = 30;
   /// m, nearest-point re-association after a descriptor registration (keyframe_tracker.cpp)
   static constexpr double kReassociateGate = 0.3;
   static constexpr double kProximityMinAngle = 0.15;  ///< rad, keyframe-to-scan yaw for it
@@ -160,7 +165,8 @@ class KeyframeTracker {
   Eigen::Matrix3d rel_T_ = Eigen::Matrix3d::Identity(), rel_C_ = Eigen::Matrix3d::Zero();  ///< inliers of the first registration to this keyframe (0 = none yet)
   // Keyframe: points at its reference time in its frame, descriptors, pose.
   std::vector<Eigen::Vector2d> key_pts_;
-  std::vector<double> key_tau_;  ///< each keyframe point's time (s) after the keyframe's reference
+  std::vector<double> key_tau_;
+  std::vector<std::pair<double, int>> key_by_x_;  ///< (x, index) of key_pts_, sorted by x  ///< each keyframe point's time (s) after the keyframe's reference
   cv::Mat key_desc_storage_, key_desc_;
   /// Keyframe: scan-start world pose and its covariance (published).
   Eigen::Matrix3d T_wj_ = Eigen::Matrix3d::Identity(), P_j_ = Eigen::Matrix3d::Zero();
