@@ -41,6 +41,7 @@ void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d&
   if (tmp_kps_.capacity() < n) tmp_kps_.reserve(n + n / 2);
   if (key_pts_.capacity() < n) key_pts_.reserve(n + n / 2);
   if (key_tau_.capacity() < n) key_tau_.reserve(n + n / 2);
+  if (key_by_x_.capacity() < n) key_by_x_.reserve(n + n / 2);
   if (matches_.capacity() < n) {  // at most one match per keyframe row
     const size_t c = n + n / 2;
     matches_.reserve(c);
