@@ -242,8 +242,8 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
       // solve keeps most of the prediction's yaw error (issue 19, tight_turns: these
       // registrations kept 69 % of the prior's yaw error, rms 0.59 deg, and carried 58 of the
       // 72 keyframe switches; azimuth peaks 4 %). So pair again under the solved pose and
-      // solve until the pose settles (ICP). Drift (400 scans, keyframe): tight_turns 0.875 ->
-      // 0.235 % (kept 11 %, rms 0.19 deg); see the README for the other columns. The
+      // solve until the pose settles (ICP). Drift (400 scans, row keypoints): tight_turns 0.88 ->
+      // 0.25 % (kept 11 %, rms 0.19 deg); see the README for the other columns. The
       // covariances stay the first solve's (nearest-point pairs of one arc are not
       // independent, see the re-association below).
       for (int r = 0; registered && r < kProximityIterations; ++r) {

@@ -49,7 +49,8 @@ Errors trackWithTruePrior(SyntheticScene& scene, int scans) {
     // The pose prior off by 0.1 m and 0.3 deg (with a covariance that says so): the
     // registration has to find the pose, not hand the prior back.
     const Eigen::Matrix3d off = se2::exp(Eigen::Vector3d(0.1, -0.05, 0.3 * kDeg));
-    pair.T_12 = k == 0 ? Eigen::Matrix3d::Identity().eval() : (scene.relative(k - 1, k) * off).eval();
+    pair.T_12 = Eigen::Matrix3d::Identity();
+    if (k > 0) pair.T_12 = scene.relative(k - 1, k) * off;
     pair.T_12_cov = Eigen::Vector3d(0.01, 0.01, 3e-5).asDiagonal();
     pair.velocity = scene.velocityAt(scene.scanStart(k) + 0.5 * scene.options().period);
     pair.velocity_cov = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();
