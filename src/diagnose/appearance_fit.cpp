@@ -29,7 +29,9 @@ using detail::physicsHasGhosts;
 
 AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
                                     const SensorConfig& sensor, const sim::PhysicsConfig& physics,
-                                    const AppearanceOptions& opt) {
+                                    const AppearanceOptions& opt_in) {
+  // The reference scene, when it is the recording's own, comes from the fit part only.
+  const AppearanceOptions opt = withReferenceScene(opt_in, recording);
   const auto t0 = std::chrono::steady_clock::now();
   if (recording.empty()) throw std::runtime_error("appearance: no scans");
   AppearanceReport rep;
