@@ -106,7 +106,7 @@ sim::World recordingWorld(const PolarScan& scan, const SensorConfig& s,
   // code 0 and the median says nothing of the speckle's spread; the upper quartile of
   // exponential speckle is 3 dB over its median, and still a floor while fewer than a quarter
   // of the rows see a return in that bin.
-  std::vector<int> floor_q(nb, 0);
+  std::vector<int> floor_q(nb, 0), iqr(nb, 0);
   std::array<int, 256> hist{};
   int rows = 0;
   for (int r = 0; r < n; ++r) rows += src[r] >= 0;
@@ -115,16 +115,28 @@ sim::World recordingWorld(const PolarScan& scan, const SensorConfig& s,
     hist.fill(0);
     for (int r = 0; r < n; ++r)
       if (src[r] >= 0) ++hist[at(r, b)];
-    int acc = 0, c = 0;
-    while (c < 255 && (acc += hist[c]) * 4 < 3 * rows) ++c;
+    int acc = 0, c = 0, q1 = -1;
+    for (; c < 255 && acc * 4 < 3 * rows; ++c) {
+      acc += hist[c];
+      if (q1 < 0 && acc * 4 >= rows) q1 = c;
+      if (acc * 4 >= 3 * rows) break;
+    }
     floor_q[b] = c;
+    iqr[b] = c - std::max(q1, 0);
   }
+  // Counts per dB for the margin: the model's, or the recording's own where its speckle is
+  // wider (a rescaled product before the code-set fit: RADIATE has 2.4 counts/dB against the
+  // base model's 1). Exponential speckle spans 6.8 dB between its quartiles; the median over
+  // the bins keeps the returns out (bins that are all code 0 give 0 and fall back to the model).
+  std::vector<int> spread = iqr;
+  std::nth_element(spread.begin(), spread.begin() + nb / 2, spread.end());
+  const double per_db = std::max(s.power_scale, spread[size_t(nb / 2)] / 6.8);
 
   // A return is a local maximum along its row within the range mainlobe (2 sigma either side).
   // Along azimuth every row keeps its own: an extended object (a wall, a car) spans rows, and
   // one scatterer per blob would render it narrower, a spurious wide beam in the fit.
   const int wb = std::max(1, int(std::ceil(2 * s.range_psf_sigma_bins)));
-  const double margin = opt.scene_margin_db * s.power_scale;
+  const double margin = opt.scene_margin_db * per_db;
   const int b0 = std::max(0, int(std::ceil(scan.binOfRange(2.5))));
   struct Peak {
     int r, b;
@@ -214,11 +226,13 @@ std::vector<PolarScan> renderRecordingScene(const SensorConfig& sensor,
   if (!opt.scene_scans || opt.scene_scans->empty())
     throw std::invalid_argument("appearance: reference scene 'recording' without recorded scans");
   // A standing sensor: every rendered scan sees its recorded scan's returns where they were.
-  const double dur = (opt.scans + 2) / std::max(sensor.rotation_hz, 0.1);
-  const sim::Trajectory standing({{0.0, {}}, {dur, {}}});
   const auto& scans = *opt.scene_scans;
+  // Every fit scan at least once: the figures of the fit part are means over all of them.
+  const int renders = std::max(opt.scans, int(scans.size()));
+  const double dur = (renders + 2) / std::max(sensor.rotation_hz, 0.1);
+  const sim::Trajectory standing({{0.0, {}}, {dur, {}}});
   std::vector<PolarScan> out;
-  for (int i = 0; i < opt.scans; ++i) {
+  for (int i = 0; i < renders; ++i) {
     const PolarScan& sc = scans[size_t(i) % scans.size()];
     sim::Simulator sim(recordingWorld(sc, sensor, opt), standing, sensor, physics, seed);
     out.push_back(sim.renderScan(i));  // scan i: its own noise

@@ -160,7 +160,8 @@ sim::World recordingWorld(const PolarScan& scan, const sim::SensorConfig& sensor
 /// `opt` with scene_scans set to the fit part of `recording` when opt.scene is "recording".
 AppearanceOptions withReferenceScene(const AppearanceOptions& opt,
                                      const std::vector<PolarScan>& recording);
-/// opt.scans scans of the recorded scenes (cycled) from a standing sensor.
+/// Scans of the recorded scenes (opt.scans, cycled, and every scene at least once) from a
+/// standing sensor.
 std::vector<PolarScan> renderRecordingScene(const sim::SensorConfig& sensor,
                                             const sim::PhysicsConfig& physics,
                                             const AppearanceOptions& opt, uint64_t seed);
