@@ -81,8 +81,13 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
   for (int i = 0; i < int(params.size()); ++i) {
     if (!opt.fit_clutter && params[i].block == 4) continue;
     if (!opt.fit_near_stc && params[i].kind == Kind::Range) continue;
+    if (opt.scene == "recording" && notIdentifiableWithOwnScene(params[i].key)) continue;
     active.push_back(i);
   }
+  if (opt.scene == "recording")
+    rep.notes.push_back("Reference scene: the recording's own returns (docs/diagnose_scene.md). "
+                        "The scene takes up the returns' gain and the beam's blur, so the receiver "
+                        "gain, its range slope and the beam width are kept as given (not fitted).");
   if (opt.fit_clutter && cur.clutter_density <= 0) cur.clutter_density = 0.05;  // start points
   if (opt.fit_near_stc && cur.stc_range <= 0) cur.stc_range = 10.0;
   if (opt.fit_clutter && cur.noise_texture_db <= 0) cur.noise_texture_db = 1.0;
