@@ -244,7 +244,7 @@ bool notIdentifiableWithOwnScene(const std::string& key) {
   // Known truth (test_appearance_scene.cpp): a beam of 2.4 deg against 1.8 came back 1.49 with
   // the recording's scene (the wider returns become more scatterers); on Boreas-RT it ran to its
   // 0.3 deg bound. The gain chain moves only the weak clutter against the scene (Oxford: radar
-  // constant 112 -> 89.5 dB with nothing named).
+  // constant 112 -> 89.5 dB). Fitted as nuisance parameters, never named.
   return key == "beam_width_deg" || key == "radar_constant_db" || key == "range_gain_db_per_decade";
 }
 

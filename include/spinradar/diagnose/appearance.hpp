@@ -157,7 +157,7 @@ std::vector<PolarScan> renderReference(const sim::SensorConfig& sensor,
 /// (the "recording" reference scene; rows masked out of `scan` are never read).
 sim::World recordingWorld(const PolarScan& scan, const sim::SensorConfig& sensor,
                           const AppearanceOptions& opt);
-/// Catalogue parameters the recording's own scene takes up (left out of the fit with it).
+/// Catalogue parameters the recording's own scene takes up: fitted, never named with it.
 bool notIdentifiableWithOwnScene(const std::string& key);
 /// `opt` with scene_scans set to the fit part of `recording` when opt.scene is "recording".
 AppearanceOptions withReferenceScene(const AppearanceOptions& opt,
