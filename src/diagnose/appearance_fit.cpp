@@ -30,8 +30,7 @@ using detail::physicsHasGhosts;
 AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
                                     const SensorConfig& sensor, const sim::PhysicsConfig& physics,
                                     const AppearanceOptions& opt_in) {
-  // The reference scene, when it is the recording's own, comes from the fit part only.
-  const AppearanceOptions opt = withReferenceScene(opt_in, recording);
+  const AppearanceOptions opt = withReferenceScene(opt_in, recording);  // its own: fit part
   const auto t0 = std::chrono::steady_clock::now();
   if (recording.empty()) throw std::runtime_error("appearance: no scans");
   AppearanceReport rep;
@@ -83,12 +82,6 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
     if (!opt.fit_near_stc && params[i].kind == Kind::Range) continue;
     active.push_back(i);
   }
-  if (opt.scene == "recording")
-    rep.notes.push_back("Reference scene: the recording's own returns (docs/diagnose_scene.md). "
-                        "The scene takes up part of the returns' gain and of the beam's blur: the "
-                        "receiver gain, its range slope and the beam width are fitted as nuisance "
-                        "parameters (kept as given they left Oxford's worst gap at 26 / 28 % "
-                        "instead of 14 / 10 %) and never named.");
   if (opt.fit_clutter && cur.clutter_density <= 0) cur.clutter_density = 0.05;  // start points
   if (opt.fit_near_stc && cur.stc_range <= 0) cur.stc_range = 10.0;
   if (opt.fit_clutter && cur.noise_texture_db <= 0) cur.noise_texture_db = 1.0;
@@ -364,10 +357,6 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
     }
     AppearanceFinding f = makeFinding(p.effect, p.key, p.unit, base, value, sd[j], size, su,
                                       practical, opt.z_min);
-    if (opt.scene == "recording" && notIdentifiableWithOwnScene(p.key)) {
-      f.named = false;  // biased with the recording's scene (appearance_scene.cpp)
-      f.verdict = "not identifiable";
-    }
     // The figure this parameter moves most (in standard errors): its gap before and after.
     Eigen::Index fi = 0;
     (J.col(j).array() / se.array()).abs().maxCoeff(&fi);
@@ -393,7 +382,7 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
       rep.after = figuresOf(cur, phys);
     }
   }
-
+  if (opt.scene == "recording") detail::markOwnSceneFindings(rep.findings, rep.notes);
   std::stable_sort(rep.findings.begin(), rep.findings.end(),
                    [](const AppearanceFinding& a, const AppearanceFinding& b) {
                      if (a.named != b.named) return a.named;
