@@ -135,6 +135,7 @@ void alignLevels(const AppearanceFigures& real, SensorConfig& cur,
 
 std::vector<PolarScan> renderReference(const SensorConfig& sensor, const sim::PhysicsConfig& physics,
                                        const AppearanceOptions& opt, uint64_t seed) {
+  if (opt.scene == "recording") return renderRecordingScene(sensor, physics, opt, seed);
   sim::Scene sc = sim::builtinScene(opt.scene);
   sim::Simulator s(std::move(sc.world), std::move(sc.trajectory), sensor, physics, seed);
   std::vector<PolarScan> out;

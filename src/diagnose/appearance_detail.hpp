@@ -73,4 +73,9 @@ AppearanceFinding fitCodeSet(const std::vector<PolarScan>& real, const Appearanc
                              const sim::PhysicsConfig& phys, const AppearanceOptions& opt,
                              std::vector<std::string>& notes);
 
+/// With the recording's own scene: the findings of notIdentifiableWithOwnScene parameters are
+/// never named (verdict "not identifiable"), and a note says why (appearance_scene.cpp).
+void markOwnSceneFindings(std::vector<AppearanceFinding>& findings,
+                          std::vector<std::string>& notes);
+
 }  // namespace spinradar::diagnose::detail

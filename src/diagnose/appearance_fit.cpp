@@ -29,7 +29,8 @@ using detail::physicsHasGhosts;
 
 AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
                                     const SensorConfig& sensor, const sim::PhysicsConfig& physics,
-                                    const AppearanceOptions& opt) {
+                                    const AppearanceOptions& opt_in) {
+  const AppearanceOptions opt = withReferenceScene(opt_in, recording);  // its own: fit part
   const auto t0 = std::chrono::steady_clock::now();
   if (recording.empty()) throw std::runtime_error("appearance: no scans");
   AppearanceReport rep;
@@ -381,7 +382,7 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
       rep.after = figuresOf(cur, phys);
     }
   }
-
+  if (opt.scene == "recording") detail::markOwnSceneFindings(rep.findings, rep.notes);
   std::stable_sort(rep.findings.begin(), rep.findings.end(),
                    [](const AppearanceFinding& a, const AppearanceFinding& b) {
                      if (a.named != b.named) return a.named;

@@ -38,6 +38,7 @@ struct DiagnoseArgs {
   bool no_holdout = false;
   bool fit_floor = false;
   bool no_cen2018_fit = false;
+  std::string appearance_scene = "city";
 };
 
 /// The appearance stage (no world or trajectory needed): findings, fitted sensor file, plots
@@ -58,9 +59,10 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   opt.holdout = !a.no_holdout;
   opt.fit_band_floor = a.fit_floor;
   opt.fit_cen2018 = !a.no_cen2018_fit;
+  opt.scene = a.appearance_scene;
   const auto rep = diagnose::diagnoseAppearance(scans, s, physics, opt);
   const std::string dir = (fs::path(a.out) / "appearance").string();
-  diagnose::writeAppearanceReport(rep, scans, opt, dir);
+  diagnose::writeAppearanceReport(rep, scans, diagnose::withReferenceScene(opt, scans), dir);
   std::cout << "appearance:";
   int named = 0;
   for (const auto& f : rep.findings)
@@ -294,6 +296,9 @@ SPINRADAR_COMMAND(
       app.add_flag("--appearance-no-cen2018-fit", a->no_cen2018_fit,
                    "Leave the Cen2018 keypoints out of the per-band calibration (still reported): "
                    "with --appearance-fit-floor on Oxford they measure the scene (docs/diagnose_cen2018.md)");
+      app.add_option("--appearance-scene", a->appearance_scene,
+                     "Reference scene of the appearance re-simulation: a built-in scene name, or "
+                     "'recording' (the recording's own fit-part returns as scatterers; issue 20)");
       app.add_option("--appearance-scans", a->appearance_scans,
                      "Re-simulated scans per evaluation in the appearance fit")
           ->capture_default_str();

@@ -6,6 +6,7 @@
 // strong returns), named from a catalogue of sensor physics, and fitted by indirect inference
 // (figure Jacobian from re-simulations with each parameter nudged). Method: docs/diagnose.md.
 #include <array>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "spinradar/core/polar_scan.hpp"
 #include "spinradar/sim/physics.hpp"
 #include "spinradar/sim/realism.hpp"
+#include "spinradar/sim/scene.hpp"
 #include "spinradar/sim/sensor_config.hpp"
 
 namespace spinradar::diagnose {
@@ -72,7 +74,14 @@ struct AppearanceLocate {
 };
 
 struct AppearanceOptions {
-  std::string scene = "city";  ///< reference scene of the re-simulation
+  /// Reference scene of the re-simulation: a built-in scene name, or "recording": the
+  /// recording's own fit-part scans as scatterers (withReferenceScene, appearance_scene.cpp).
+  std::string scene = "city";
+  /// "recording" scene: a return is a local maximum this far above its range bin's upper quartile
+  /// (over the upper quartile; exponential speckle exceeds that in 1e-6 of the cells).
+  double scene_margin_db = 10.0;
+  /// "recording" scene: the scans it is taken from (set by withReferenceScene).
+  std::shared_ptr<const std::vector<PolarScan>> scene_scans;
   int scans = 4;               ///< re-simulated scans per evaluation
   uint64_t seed = 11;
   int iterations = 4;          ///< Newton steps of the indirect-inference fit
@@ -143,6 +152,21 @@ struct AppearanceReport {
 std::vector<PolarScan> renderReference(const sim::SensorConfig& sensor,
                                        const sim::PhysicsConfig& physics,
                                        const AppearanceOptions& opt, uint64_t seed);
+
+/// Scatterers of one recorded scan in the sensor frame, strengths for `sensor`'s gain chain
+/// (the "recording" reference scene; rows masked out of `scan` are never read).
+sim::World recordingWorld(const PolarScan& scan, const sim::SensorConfig& sensor,
+                          const AppearanceOptions& opt);
+/// Catalogue parameters the recording's own scene takes up: fitted, never named with it.
+bool notIdentifiableWithOwnScene(const std::string& key);
+/// `opt` with scene_scans set to the fit part of `recording` when opt.scene is "recording".
+AppearanceOptions withReferenceScene(const AppearanceOptions& opt,
+                                     const std::vector<PolarScan>& recording);
+/// Scans of the recorded scenes (opt.scans, cycled, and every scene at least once) from a
+/// standing sensor.
+std::vector<PolarScan> renderRecordingScene(const sim::SensorConfig& sensor,
+                                            const sim::PhysicsConfig& physics,
+                                            const AppearanceOptions& opt, uint64_t seed);
 
 /// The appearance stage on `real` against the base model `sensor` / `physics` (the geometry
 /// fields of `sensor`, bins, resolution, azimuths, must be the recording's).
