@@ -227,6 +227,20 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     Eigen::Matrix<double, 6, 6> cov;
     Eigen::Matrix3d T = T_odo;
     registered = solve(T_odo, C_odo, xi_prior, Cxi, Cxi_honest, T, xi, cov, cov_pub, cov_acc);
+    // Pair every keypoint with the nearest keyframe point (within `gate`) under the solved
+    // pose and solve again; a failed solve keeps the previous pose. The covariances stay the
+    // first registration's (see the two uses below).
+    auto pairAndSolveAgain = [&](double gate) {
+      const Eigen::Matrix3d T_was = T;
+      const Eigen::Vector3d xi_was = xi;
+      Eigen::Matrix<double, 6, 6> unused_cov, unused_pub, unused_acc;
+      associateByProximity(cur, T, xi, c, gate);
+      if (solve(T_odo, C_odo, xi_prior, Cxi, Cxi_honest, T, xi, unused_cov, unused_pub, unused_acc))
+        return true;
+      T = T_was;
+      xi = xi_was;
+      return false;
+    };
     // Descriptors failed against a keyframe turned far from this scan (ORB on the Cartesian
     // image changes with the heading): pair keypoints by proximity to the prediction. Only
     // there: on straights the descriptors fail for other reasons (few distinct returns) and
@@ -248,14 +262,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
       // independent, see the re-association below).
       for (int r = 0; registered && r < kProximityIterations; ++r) {
         const Eigen::Matrix3d T_was = T;
-        const Eigen::Vector3d xi_was = xi;
-        Eigen::Matrix<double, 6, 6> c1, c2, c3;
-        associateByProximity(cur, T, xi, c, kProximityRegate);
-        if (!solve(T_odo, C_odo, xi_prior, Cxi, Cxi_honest, T, xi, c1, c2, c3)) {
-          T = T_was;
-          xi = xi_was;
-          break;
-        }
+        if (!pairAndSolveAgain(kProximityRegate)) break;
         const Eigen::Vector3d d = se2::log(se2::inverse(T_was) * T);
         if (d.head<2>().norm() < 1e-4 && std::abs(d(2)) < 1e-5) break;
       }
@@ -271,16 +278,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     // The covariances stay the descriptor solve's: the rows of one return, each its own
     // nearest-point pair, are not independent, and counting them made the accumulated-pose
     // NEES 9.8 on a city layout (test_keyframe_row_quantization).
-    if (registered) {
-      const Eigen::Matrix3d T1 = T;
-      const Eigen::Vector3d xi1 = xi;
-      Eigen::Matrix<double, 6, 6> cov2, cov_pub2, cov_acc2;
-      associateByProximity(cur, T, xi, c, kReassociateGate);
-      if (!solve(T_odo, C_odo, xi_prior, Cxi, Cxi_honest, T, xi, cov2, cov_pub2, cov_acc2)) {
-        T = T1;
-        xi = xi1;
-      }
-    }
+    if (registered) pairAndSolveAgain(kReassociateGate);
     if (registered) {
       T_jk = T;
       const Eigen::Matrix3d L = se2::leftPerturbationToXyYaw(T);
