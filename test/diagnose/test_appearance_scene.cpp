@@ -102,8 +102,11 @@ TEST(AppearanceScene, SensorRecoveredOnAnotherSceneWithItsOwnScene) {
         EXPECT_TRUE(named.empty()) << hidden << ": " << named;
       }
       // Not identifiable with the recording's scene: fitted, never named, and said so.
-      for (const auto& f : rep.findings)
-        if (notIdentifiableWithOwnScene(f.parameter)) EXPECT_EQ(f.verdict, "not identifiable");
+      for (const auto& f : rep.findings) {
+        if (notIdentifiableWithOwnScene(f.parameter)) {
+          EXPECT_EQ(f.verdict, "not identifiable") << f.parameter;
+        }
+      }
     }
   }
 }
