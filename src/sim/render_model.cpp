@@ -26,13 +26,6 @@ double nearStc(const SensorConfig& s, double r) {
 
 double sinc(double x) { return std::abs(x) < 1e-9 ? 1.0 : std::sin(M_PI * x) / (M_PI * x); }
 
-// Amplitude response of a Hann-windowed FFT, x in resolution cells (first null at |x| = 2).
-double hannResponse(double x) {
-  double d = 1.0 - x * x;
-  if (std::abs(d) < 1e-9) return 0.5;
-  return sinc(x) / d;
-}
-
 }  // namespace
 
 RenderModel::RenderModel(const SensorConfig& s) : s_(s) {

@@ -47,7 +47,13 @@ TEST(NavtechCapture, RecordThenReplayGivesIdenticalScans) {
     ServerOptions o;
     o.rate = 5;
     o.log = [](LogLevel, const std::string&) {};
-    o.faults = {{700, K::Garbage, 300}, {1300, K::Disconnect}};
+    ServerFault garbage, disconnect;
+    garbage.at_azimuth = 700;
+    garbage.kind = K::Garbage;
+    garbage.value = 300;
+    disconnect.at_azimuth = 1300;
+    disconnect.kind = K::Disconnect;
+    o.faults = {garbage, disconnect};
     NavtechServer server(o, patternSource());
     server.start();
     DriverConfig c = fastDriverConfig(server.port());
