@@ -47,6 +47,7 @@ void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d&
     matches_.reserve(c);
     for (auto* v : {&qx_, &qy_, &px_, &py_, &ux_, &uy_, &tau_, &key_tau_m_}) v->reserve(c);
     in_.reserve(c);
+    dirs_.reserve(c);
   }
   dopplerCorrect(f.keypoints, xi, config_.beta, tmp_kps_);
   const int64_t ref_ns = f.stamp_ns + static_cast<int64_t>(std::llround(1e9 * c));
@@ -100,6 +101,7 @@ void KeyframeTracker::associateByProximity(const FeatureFrame& cur, const Eigen:
   if (qx_.capacity() < n) {  // rare: a scan with more keypoints than the keyframe's headroom
     for (auto* v : {&qx_, &qy_, &px_, &py_, &ux_, &uy_, &tau_, &key_tau_m_}) v->reserve(n + n / 2);
     in_.reserve(n + n / 2);
+    dirs_.reserve(n + n / 2);
   }
   const double gate2 = gate * gate;
   const double beta = config_.beta;

@@ -12,9 +12,7 @@
 namespace spinradar {
 
 namespace {
-
 double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
-
 }  // namespace
 
 KeyframeTracker::KeyframeTracker(const EstimatorConfig& config) : config_(config) {}
@@ -47,6 +45,7 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
     const double gate2 = gate * gate;
     A.setZero();
     B.setZero();
+    dirs_.clear();
     Vec6 b = Vec6::Zero();
     Eigen::Vector3d rp = se2::toXyYaw(T) - prior_pose;
     rp(2) = wrapAngle(rp(2));
@@ -86,6 +85,9 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
       const Eigen::Matrix<double, 6, 2> JtW = J.transpose() * Si;
       A.noalias() += JtW * J;
       b.noalias() -= JtW * e;
+      // Radial direction for the residual scales (cov_acc): between the two points' own.
+      const Eigen::Vector2d u = (q.normalized() + (CC * pc).normalized()).normalized();
+      dirs_.add(e, S, u.allFinite() ? u : Eigen::Vector2d::UnitX(), JtW);
       // Acceleration within this scan moves the point by exp(tau^2/2 a) and within the
       // keyframe's scan its map point by exp(tau_j^2/2 a_j): residual sensitivities.
       const double tj = key_tau_m_[m];
@@ -123,28 +125,29 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
   Ah.bottomRightCorner<3, 3>() += Cxi_honest.inverse() - Wv;
   cov_pub = Ah.inverse() * (chi2 / dof);
   // The one the accumulated pose chains (issue 19): the error of the estimate this solve
-  // actually makes. Measured per registration against the truth (400 scans of city,
-  // tight_turns, out_and_back): yaw error rms 0.06-0.10 deg on straights but 0.28-0.60 deg
-  // in turns, the solved yaw rate 0.05-0.07 rad/s off in turns against a 0.011 sigma, so
-  // that the accumulated-pose NEES reached 9.3 (city_narrow) / 6.0 (tight_turns). Two model
-  // errors were left out:
-  //  - the estimate weighs the velocity prior as if it lagged a tenth of a scan
-  //    (kPriorLag), its error is that of half a scan (Cxi_honest): the sandwich
-  //    At^-1 (H s + Wv Cxi_honest Wv) At^-1 of the weights used (At: A without the pose
-  //    prior, which is not independent, see above) instead of Ah^-1;
+  // actually makes, the sandwich At^-1 M At^-1 of the weights used (At: A without the pose
+  // prior, not independent, see above), its meat M from three error sources:
+  //  - the matches' residuals, scaled apart along each match's radial and tangential
+  //    direction (DirectionScales: median-based, floor kMinResidualScale), not by one
+  //    chi2/dof: azimuth peaks have about half the tangential error of row keypoints, a
+  //    narrow range PSF a smaller radial one, and one factor cannot follow either;
+  //  - the velocity prior weighed as if it lagged a tenth of a scan (kPriorLag) has the
+  //    error of half a scan (kHonestLag): Wv Cxi_acc_ Wv, the velocity change over that lag
+  //    from the acceleration seen plus the step model's white noise (kStep*Sigma). The
+  //    white-noise kAccelSigma / kAngAccelSigma of Cxi_honest (3 m/s^2, 1 rad/s^2) made it
+  //    the largest term on straights: accumulated-pose NEES 0.8-1.7 with azimuth peaks on
+  //    11 of 12 simulated matrix columns (400 scans), 1.1-3.4 with this;
   //  - constant velocity within a scan: the scan's and the keyframe's own accelerations
   //    move each point by exp(tau^2/2 a) in its scan, an error common to all points that
-  //    averaging does not shrink, so it is considered (Schmidt): At^-1 B Q B^T At^-1, Q the
-  //    squares of the accelerations seen over the scan period before each (accel_,
-  //    key_accel_: 0 on straights at constant speed, ~1 rad/s^2 where a turn eases in or
-  //    out). The white-noise kAccelSigma / kAngAccelSigma instead made the synthetic drives
-  //    of test_keyframe_tracker (yaw acceleration <= 0.16 rad/s^2) cautious 16x (final-pose
-  //    NEES 0.18); the seen acceleration: 0.72 there, city_narrow 7.6 against 5.0.
+  //    averaging does not shrink (Schmidt): B Q B^T, Q the squares of the accelerations seen
+  //    over the scan period before each (accel_, key_accel_). White noise there instead made
+  //    the synthetic drives of test_keyframe_tracker cautious 16x (final-pose NEES 0.18).
   // The pose and this solve are unchanged: covariance only.
   Mat6 At = A;
   At.topLeftCorner<3, 3>() -= Ap;
-  Mat6 M = At * (chi2 / dof);
-  M.bottomRightCorner<3, 3>() += (Wv * Cxi_honest * Wv - Wv * (chi2 / dof)).eval();
+  dirs_.estimate(6, kMinResidualScale);
+  Mat6 M = dirs_.meat();
+  M.bottomRightCorner<3, 3>() += Wv * Cxi_acc_ * Wv;
   Vec6 q;
   q << accel_, key_accel_;
   M.noalias() += B * q.cwiseAbs2().asDiagonal() * B.transpose();
@@ -223,6 +226,10 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     accel_ = ((pair.velocity - prev_xi_) / dt).cwiseAbs();
     Eigen::Matrix3d Cxi_honest = pair.velocity_cov;
     Cxi_honest.diagonal() += Eigen::Vector3d(hl * hl, hl * hl, ha * ha);
+    // The same lag for cov_acc: seen acceleration plus the step model's noise (see solve()).
+    const Eigen::Vector3d q2(kStepAccelSigma, kStepAccelSigma, kStepAngAccelSigma);
+    Cxi_acc_ = pair.velocity_cov;
+    Cxi_acc_.diagonal() += (accel_.cwiseAbs2() + q2.cwiseAbs2()) * std::pow(kHonestLag * dt, 2);
     Eigen::Vector3d xi = xi_prior;
     Eigen::Matrix<double, 6, 6> cov;
     Eigen::Matrix3d T = T_odo;

@@ -57,6 +57,7 @@
 
 #include "spinradar/core/feature_frame.hpp"
 #include "spinradar/features/matcher.hpp"
+#include "spinradar/estimation/direction_scales.hpp"
 #include "spinradar/estimation/motion_estimate.hpp"
 #include "spinradar/core/params.hpp"
 
@@ -130,6 +131,10 @@ class KeyframeTracker {
   /// Scan periods: the lag the pair velocity really has (its centre is half a scan before
   /// this scan's), for the published covariance only (kPriorLag steers the estimate).
   static constexpr double kHonestLag = 0.5;
+  /// Floor of the residual scales (variance factors on the configured noise) of the
+  /// accumulated pose's covariance, radial and tangential (see direction_scales.hpp): a
+  /// tangential sigma at least 0.22 of azimuth_sigma (peaks, city_wide: median k_t 0.06).
+  static constexpr double kMinResidualScale = 0.05;
 
  private:
   /// f becomes the keyframe: T_w, P its (published) scan-start pose and covariance, xi its
@@ -162,6 +167,8 @@ class KeyframeTracker {
   int64_t key_stamp_ = 0, rel_key_stamp_ = 0;
   /// The keyframe's velocity covariance (published one): its map's own uncertainty.
   Eigen::Matrix3d key_xi_cov_ = Eigen::Matrix3d::Zero();
+  /// The velocity prior's error over its real lag for cov_acc (see track()).
+  Eigen::Matrix3d Cxi_acc_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d rel_T_ = Eigen::Matrix3d::Identity(), rel_C_ = Eigen::Matrix3d::Zero();  ///< inliers of the first registration to this keyframe (0 = none yet)
   // Keyframe: points at its reference time in its frame, descriptors, pose.
   std::vector<Eigen::Vector2d> key_pts_;
@@ -183,6 +190,7 @@ class KeyframeTracker {
   std::vector<double> qx_, qy_, px_, py_, ux_, uy_, tau_;
   std::vector<double> key_tau_m_;  ///< the matched keyframe point's key_tau_
   std::vector<char> in_;
+  DirectionScales<6> dirs_;  ///< per-direction residual scales of the solve (cov_acc)
   /// Fills the match arrays by proximity to the prediction (see kProximityGate).
   void associateByProximity(const FeatureFrame& cur, const Eigen::Matrix3d& T_pred,
                             const Eigen::Vector3d& xi, double c, double gate);
