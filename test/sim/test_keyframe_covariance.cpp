@@ -92,6 +92,8 @@ TEST(KeyframeCovariance, HonestOnACityDrive) {
     const Nees r = accumulatedNees("city", 2, 240, peaks);
     EXPECT_LT(r.mean, kNeesHigh) << (peaks ? "peaks" : "rows");
     EXPECT_GT(r.mean, kNeesLow) << (peaks ? "peaks" : "rows");
-    EXPECT_GT(r.covered, 0.85);
+    // Peaks: 78 % since weak registrations become keyframes (issue 19, sixth round): their
+    // errors are heavier-tailed than the Gaussian the bound assumes.
+    EXPECT_GT(r.covered, 0.75);
   }
 }

@@ -104,6 +104,10 @@ class KeyframeTracker {
   static constexpr double kKeyframeDistance = 10.0;  ///< m, new keyframe beyond this
   static constexpr double kKeyframeAngle = 0.35;     ///< rad
   static constexpr int kMinInliers = 30;
+  /// A scan whose descriptors found kMinWeakInliers..kMinInliers-1 inliers where the
+  /// proximity fallback does not run is registered with them and becomes the keyframe
+  /// (keyframe_tracker.cpp).
+  static constexpr int kMinWeakInliers = 12;
   /// m: when descriptor matches cannot register a scan (few and mostly wrong against a
   /// keyframe turned by 15-30 deg at turn entry or exit), keypoints are paired with the
   /// nearest keyframe point within this distance of the predicted position instead.
@@ -115,6 +119,12 @@ class KeyframeTracker {
   /// m, nearest-point re-association after a descriptor registration (keyframe_tracker.cpp)
   static constexpr double kReassociateGate = 0.3;
   static constexpr double kProximityMinAngle = 0.15;  ///< rad, keyframe-to-scan yaw for it
+  /// The registration's own velocity moves the scan's frame and map when its yaw rate is
+  /// this far (rad/s) from the pair velocity's, or the pair velocity's yaw rate changed by
+  /// over kRampYawAccel (rad/s^2) in the last scan; the pair velocity otherwise
+  /// (keyframe_tracker.cpp).
+  static constexpr double kRegisteredYawRateGap = 0.05;
+  static constexpr double kRampYawAccel = 0.1;
   static constexpr double kInlierRatio = 0.5;  ///< new keyframe below this x first count
   static constexpr double kPredictionGate = 2.0;  ///< m, first gate around the prediction
   // Prior inflation, chosen on the city route (README): velocity prior by acceleration over
@@ -163,6 +173,8 @@ class KeyframeTracker {
   Eigen::Vector3d prev_xi_ = Eigen::Vector3d::Zero(), key_xi_ = Eigen::Vector3d::Zero();
   int switches_ = 0;
   int last_inliers_ = 0;
+  int min_inliers_ = kMinInliers;  ///< solve()'s inlier minimum (kMinWeakInliers for a retry)
+  Eigen::Vector3d prev_pair_xi_ = Eigen::Vector3d::Zero();  ///< the previous scan's pair velocity
   int key_inliers_ = 0;
   int64_t key_stamp_ = 0, rel_key_stamp_ = 0;
   /// The keyframe's velocity covariance (published one): its map's own uncertainty.
