@@ -21,21 +21,23 @@ void setMotionFromVelocity(const Eigen::Vector3d& xi, const Eigen::Matrix3d& xi_
 }
 
 Eigen::Matrix2d cartesianInformation(const Eigen::Vector2d& p, double range_sigma,
-                                     double azimuth_sigma) {
+                                     double azimuth_sigma, double tangential_floor) {
   // H = d(x, y)/d(r, phi) = [[cos phi, -r sin phi], [-sin phi, -r cos phi]] (REP 103,
   // clockwise phi); H R H^T = sr^2 u u^T + (r sa)^2 w w^T with u = p/r radial and w its
   // normal, whose inverse is u u^T / sr^2 + w w^T / (r sa)^2 = a u u^T + b 1.
   const double r2 = std::max(p.squaredNorm(), 1.0);
-  const double inv_t = 1.0 / (r2 * azimuth_sigma * azimuth_sigma);
+  const double inv_t =
+      1.0 / (r2 * azimuth_sigma * azimuth_sigma + tangential_floor * tangential_floor);
   const double inv_r = 1.0 / (range_sigma * range_sigma);
   const Eigen::Vector2d u = p / std::sqrt(r2);
   return (inv_r - inv_t) * u * u.transpose() + inv_t * Eigen::Matrix2d::Identity();
 }
 
 Eigen::Matrix2d cartesianCovariance(const Eigen::Vector2d& p, double range_sigma,
-                                    double azimuth_sigma) {
+                                    double azimuth_sigma, double tangential_floor) {
   const double r2 = std::max(p.squaredNorm(), 1.0);
-  const double vt = r2 * azimuth_sigma * azimuth_sigma, vr = range_sigma * range_sigma;
+  const double vt = r2 * azimuth_sigma * azimuth_sigma + tangential_floor * tangential_floor;
+  const double vr = range_sigma * range_sigma;
   const Eigen::Vector2d u = p / std::sqrt(r2);
   return (vr - vt) * u * u.transpose() + vt * Eigen::Matrix2d::Identity();
 }
@@ -140,7 +142,7 @@ bool McRansac::gaussNewton(const int* idx, int n, int iterations, Eigen::Vector3
       const Eigen::Vector2d e = Eigen::Vector2d(x2_[m], y2_[m]) - g;
       Eigen::Matrix<double, 2, 3> G = dt * se2::odot2(g);
       // R_cart = H R H^T evaluated at g_bar (the paper's H_m).
-      const Eigen::Matrix2d W = cartesianInformation(g, sr, sa);
+      const Eigen::Matrix2d W = cartesianInformation(g, sr, sa, tangential_floor_);
       const Eigen::Matrix<double, 3, 2> GtW = G.transpose() * W;
       A.noalias() += GtW * G;
       b.noalias() += GtW * e;
@@ -228,11 +230,12 @@ bool McRansac::covariance(const std::vector<int>& inliers, double dt_ref,
     const Eigen::Vector2d g = transformPoint(varpi, dt, p1.x(), p1.y(), &c, &sn);
     const Eigen::Vector2d e = p2 - g;
     const Eigen::Matrix<double, 2, 3> G = dt * se2::odot2(g);
-    const Eigen::Matrix2d W = cartesianInformation(g, sr, sa);
+    const Eigen::Matrix2d W = cartesianInformation(g, sr, sa, tangential_floor_);
     Eigen::Matrix2d C;
     C << c, -sn, sn, c;
     const Eigen::Matrix2d S =
-        cartesianCovariance(p2, sr, sa) + C * cartesianCovariance(p1, sr, sa) * C.transpose();
+        cartesianCovariance(p2, sr, sa, tangential_floor_) +
+        C * cartesianCovariance(p1, sr, sa, tangential_floor_) * C.transpose();
     const Eigen::Matrix<double, 3, 2> GtW = G.transpose() * W;
     A.noalias() += GtW * G;
     B.noalias() += GtW * S * GtW.transpose();

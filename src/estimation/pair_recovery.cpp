@@ -212,7 +212,8 @@ bool PairRecovery::estimate(const FeatureFrame& f1, const FeatureFrame& f2,
       J.leftCols<3>() = Jm - dt * se2::odot2(q) * Jl;
       J.rightCols<3>() = -RT * Jg;
       const Eigen::Matrix2d Si =
-          (cartesianCovariance(map_[j], sr, sa) + cartesianCovariance(q, sr, sa)).inverse();
+          (cartesianCovariance(map_[j], sr, sa, kTangentialFloor) +
+           cartesianCovariance(q, sr, sa, kTangentialFloor)).inverse();
       const Eigen::Matrix<double, 6, 2> JtW = J.transpose() * Si;
       A.noalias() += JtW * J;
       b.noalias() -= JtW * e;

@@ -17,6 +17,7 @@ RefinedEstimator::RefinedEstimator(const EstimatorConfig& config) { setConfig(co
 void RefinedEstimator::setConfig(const EstimatorConfig& config) {
   config_ = config;
   mc_.setConfig(config);
+  mc_.setTangentialFloor(kTangentialFloor);  // its start and gate too (Oxford pair 1)
 }
 
 namespace {
@@ -73,7 +74,8 @@ bool RefinedEstimator::optimise(Eigen::Vector3d& varpi, Eigen::Matrix3d& cov,
                                             C * dopplerJacobian(u1x_[m], u1y_[m], beta) -
                                             dopplerJacobian(u2x_[m], u2y_[m], beta);
       const Eigen::Matrix2d S =
-          cartesianCovariance(p2, sr, sa) + C * cartesianCovariance(p1, sr, sa) * C.transpose();
+          cartesianCovariance(p2, sr, sa, kTangentialFloor) +
+          C * cartesianCovariance(p1, sr, sa, kTangentialFloor) * C.transpose();
       const Eigen::Matrix2d Si = S.inverse();
       const double r2 = e.dot(Si * e);
       r2_[m] = r2;
