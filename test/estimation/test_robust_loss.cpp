@@ -77,11 +77,15 @@ TEST(RobustLoss, CoherentErrorsInsideTheGateDoNotPullTheYaw) {
     const double robust = yawRateError(p, true, true);
     std::cout << "[ info ] refined seed " << seed << ": yaw-rate error plain " << plain
               << " deg/s, Cauchy " << robust << "\n";
-    // The shifted quarter biases plain least squares by about a quarter of its mean angular
-    // offset (0.38-0.48 deg/s); the Cauchy weights, scaled by the median residual, take off
-    // about 40 % of it (Cauchy weights never reach zero: 25 % of coherent errors still pull).
-    EXPECT_GT(plain, 0.2) << "the planted error must bias plain least squares";
-    EXPECT_LT(robust, 0.75 * plain);
+    // The shifted quarter biased plain least squares by about a quarter of its mean angular
+    // offset (0.38-0.48 deg/s) under the paper's weights; the Cauchy weights, scaled by the
+    // median residual, took off about 40 % of it (0.22-0.27). With the tangential noise floor
+    // (kTangentialFloor, issue 19) the near matches no longer carry the yaw and the plain
+    // refit is already there (0.23 deg/s); the Cauchy weights still take off 3-9 % (0.21-0.23)
+    // (Cauchy weights never reach zero: 25 % of coherent errors still pull).
+    EXPECT_GT(plain, 0.15) << "the planted error must bias plain least squares";
+    EXPECT_LT(robust, plain);
+    EXPECT_LT(robust, 0.27);
   }
 }
 

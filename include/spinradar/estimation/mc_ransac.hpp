@@ -34,16 +34,19 @@ namespace spinradar {
 void setMotionFromVelocity(const Eigen::Vector3d& xi, const Eigen::Matrix3d& xi_cov,
                            double dt_ref, MotionEstimate& out);
 
-/// Tangential position noise that does not shrink with range (m), used by refined (and its
-/// MC-RANSAC start), the keyframe registration and the pair recovery; mc and mc_doppler keep
-/// the paper's R_cart (floor 0). Issue 19: after the fit, real Oxford matches (azimuth peaks,
-/// 3 pairs) spread 0.16 m across the beam under 20 m, 3x the 0.054 m that azimuth_sigma
-/// gives at 12 m, and 0.13-0.20 m beyond (flat, not ~r): the scattering centre of a near
-/// extended object (car, wall, post) moves with the aspect angle, which near objects change
-/// fastest. Without a floor the near points' tangential residuals got 10-50x the weight of
-/// the far ones' and carried the yaw (Oxford pair 1: -0.13 deg with, +0.02 without them).
-/// Measured 0.1-0.3 m (keyframe, azimuth peaks): Oxford pairs 0.059 -> 0.037 deg, skip pair
-/// 0.109 -> 0.035, RADIATE consistency 0.184 -> 0.112 deg (0.2 m); see the commit message.
+/// Tangential position noise that does not shrink with range (m), used by the pair estimate
+/// of refined (and its MC-RANSAC start) and by the pair recovery. mc and mc_doppler keep the
+/// paper's R_cart (floor 0); so does the keyframe registration (see below). Issue 19: after
+/// the fit, real Oxford matches (azimuth peaks, 3 pairs) spread 0.16 m across the beam under
+/// 20 m, 3x the 0.054 m that azimuth_sigma gives at 12 m, and 0.13-0.20 m beyond (flat, not
+/// ~r): the scattering centre of a near extended object (car, wall, post) moves with the
+/// aspect angle, which near objects change fastest. Without a floor the near points'
+/// tangential residuals got 10-50x the weight of far ones' and carried the yaw (Oxford pair
+/// 1, same inliers and times: -0.133 deg with the paper's weights, +0.024 with unit weights).
+/// The keyframe registration is left out: there the floor shrank the points' information
+/// against the tuned pose and velocity priors, and a yaw-rate step inside a scan (0.7 deg)
+/// stayed in the chain (test_keyframe_tracker YawRateStepInsideAScanStaysOutOfTheChain,
+/// test_keyframe_row_smears).
 constexpr double kTangentialFloor = 0.2;
 
 /// Inverse of the Cartesian covariance R_cart = H R H^T of a point p = h(r, phi) with
