@@ -213,6 +213,7 @@ SensorConfig fitRangeCurves(const sim::RealismStats& real, const SensorConfig& s
     if (full) for (int c = 0; c < kCols; ++c) {
       const int t = std::min(c / kBands, kTypes), j = c - t * kBands;
       if (t == kTypes && j == 2 && cur.native_codes != 0) continue;  // column stays zero
+      if (t == 1 && opt.hold_gain_chain) continue;  // the returns' level is held (combined)
       SensorConfig s = cur;
       setParam(s, t, j, getParam(cur, t, j) + step[t]);
       Eigen::VectorXd f;
@@ -228,7 +229,8 @@ SensorConfig fitRangeCurves(const sim::RealismStats& real, const SensorConfig& s
         const int t = std::min(c / kBands, kTypes);
         N(c, c) += lambda / (scale[t] * scale[t]);
       }
-      const Eigen::VectorXd d = N.ldlt().solve(J.transpose() * w.asDiagonal() * r);
+      Eigen::VectorXd d = N.ldlt().solve(J.transpose() * w.asDiagonal() * r);
+      if (opt.hold_gain_chain) d.segment(kBands, kBands).setZero();  // type 1: returns' level
       SensorConfig trial = cur;
       // Type 0 before type 1: setting the noise level keeps the returns' level.
       for (int c = 0; c < kCols; ++c) {

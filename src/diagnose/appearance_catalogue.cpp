@@ -103,7 +103,7 @@ Eigen::VectorXd differenceSe(const AppearanceFigures& a, const AppearanceFigures
 // in up to 3 rounds, each re-simulated; the fit does the rest.
 void alignLevels(const AppearanceFigures& real, SensorConfig& cur,
                  const std::function<AppearanceFigures(const SensorConfig&)>& figuresOf,
-                 std::vector<std::string>& notes) {
+                 std::vector<std::string>& notes, bool hold_gain) {
   auto gap = [](const std::array<double, kBands>& r, const std::array<double, kBands>& s) {
     double g = 0;
     int n = 0;
@@ -116,7 +116,7 @@ void alignLevels(const AppearanceFigures& real, SensorConfig& cur,
     const AppearanceFigures f = figuresOf(cur);
     const double noise = gap(real.floor, f.floor), gain = gap(real.bright, f.bright);
     const bool move_noise = std::abs(noise) > 18 || (round > 0 && std::abs(noise) > 6);
-    const bool move_gain = std::abs(gain) > 27 || (round > 0 && std::abs(gain) > 9);
+    const bool move_gain = !hold_gain && (std::abs(gain) > 27 || (round > 0 && std::abs(gain) > 9));
     if (!move_noise && !move_gain) break;
     if (move_noise) cur.noise_floor_db = std::clamp(cur.noise_floor_db + noise, 0.0, 100.0);
     if (move_gain) cur.radar_constant_db = std::clamp(cur.radar_constant_db + gain, 0.0, 300.0);

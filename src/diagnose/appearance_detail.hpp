@@ -37,7 +37,7 @@ Eigen::VectorXd differenceSe(const AppearanceFigures& a, const AppearanceFigures
 /// gaps exceed what the fit's trust region covers (notes say so); figuresOf re-simulates.
 void alignLevels(const AppearanceFigures& real, sim::SensorConfig& cur,
                  const std::function<AppearanceFigures(const sim::SensorConfig&)>& figuresOf,
-                 std::vector<std::string>& notes);
+                 std::vector<std::string>& notes, bool hold_gain = false);
 /// Fills rep.locate from rep.real / rep.before.
 void locateAppearance(AppearanceReport& rep);
 /// Realism figures of the recording and of the reference re-simulated before/after the fit.

@@ -30,6 +30,7 @@ using detail::physicsHasGhosts;
 AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
                                     const SensorConfig& sensor, const sim::PhysicsConfig& physics,
                                     const AppearanceOptions& opt_in) {
+  if (opt_in.scene == "combined") return combinedAppearance(recording, sensor, physics, opt_in);
   const AppearanceOptions opt = withReferenceScene(opt_in, recording);  // its own: fit part
   const auto t0 = std::chrono::steady_clock::now();
   if (recording.empty()) throw std::runtime_error("appearance: no scans");
@@ -71,30 +72,27 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
                           "only bounded from below.");
   }
 
-  rep.findings.push_back(detail::fitCodeSet(real, rep.real, rep.before, cur, phys, opt, rep.notes));  // --- Smooth parameters: block-wise Gauss-Newton on the figures. Each block of parameters is
+  rep.findings.push_back(detail::fitCodeSet(real, rep.real, rep.before, cur, phys, opt, rep.notes));
+  // --- Smooth parameters: block-wise Gauss-Newton on the figures. Each block of parameters is
   // fitted to the figures it moves most (block-diagonal Jacobian from re-simulations with each
   // parameter nudged, common random numbers); the blocks are iterated jointly so that their
   // cross-talk (a wider range spread also changes the CA-CFAR texture) is taken up.
   const auto& params = appearanceParams();
   std::vector<int> active;
   for (int i = 0; i < int(params.size()); ++i) {
-    if (!opt.fit_clutter && params[i].block == 4) continue;
-    if (!opt.fit_near_stc && params[i].kind == Kind::Range) continue;
+    if ((!opt.fit_clutter && params[i].block == 4) ||
+        (!opt.fit_near_stc && params[i].kind == Kind::Range))
+      continue;
+    if (opt.hold_gain_chain && notIdentifiableWithOwnScene(params[i].key)) continue;  // combined
     active.push_back(i);
   }
   if (opt.fit_clutter && cur.clutter_density <= 0) cur.clutter_density = 0.05;  // start points
   if (opt.fit_near_stc && cur.stc_range <= 0) cur.stc_range = 10.0;
   if (opt.fit_clutter && cur.noise_texture_db <= 0) cur.noise_texture_db = 1.0;
-  alignLevels(rep.real, cur, [&](const SensorConfig& s) { return figuresOf(s, phys); }, rep.notes);
-  const bool moved = cur.radar_constant_db != sensor.radar_constant_db ||
-                     cur.noise_floor_db != sensor.noise_floor_db ||
-                     cur.noise_range_slope_db_per_decade != sensor.noise_range_slope_db_per_decade ||
-                     cur.range_gain_db_per_decade != sensor.range_gain_db_per_decade ||
-                     cur.saturation != sensor.saturation ||
-                     cur.clutter_density != sensor.clutter_density ||
-                     cur.stc_range != sensor.stc_range || cur.noise_texture_db != sensor.noise_texture_db ||
-                     cur.native_codes != sensor.native_codes || cur.power_scale != sensor.power_scale;
-  AppearanceFigures fig_cur = moved ? figuresOf(cur, phys) : rep.before;
+  alignLevels(rep.real, cur, [&](const SensorConfig& s) { return figuresOf(s, phys); }, rep.notes,
+              opt.hold_gain_chain);
+  // Re-simulated even when nothing moved: the same seed gives rep.before again.
+  AppearanceFigures fig_cur = figuresOf(cur, phys);
   Eigen::VectorXd e_cur = detail::figureVector(fig_cur);
   const Eigen::VectorXd e_real = detail::figureVector(rep.real);
   Eigen::VectorXd se = detail::differenceSe(rep.real, fig_cur);
@@ -382,7 +380,7 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
       rep.after = figuresOf(cur, phys);
     }
   }
-  if (opt.scene == "recording") detail::markOwnSceneFindings(rep.findings, rep.notes);
+  if (opt.scene == "recording" && !opt.hold_gain_chain) detail::markOwnSceneFindings(rep.findings, rep.notes);
   std::stable_sort(rep.findings.begin(), rep.findings.end(),
                    [](const AppearanceFinding& a, const AppearanceFinding& b) {
                      if (a.named != b.named) return a.named;

@@ -268,6 +268,7 @@ void markOwnSceneFindings(std::vector<AppearanceFinding>& findings,
 AppearanceOptions withReferenceScene(const AppearanceOptions& opt,
                                      const std::vector<PolarScan>& recording) {
   AppearanceOptions o = opt;
+  if (o.scene == "combined") o.scene = "recording", o.hold_gain_chain = true;  // its 2nd stage
   if (o.scene != "recording") return o;
   // The scene comes from the fit part only, so the held-out figures stay a check.
   std::vector<PolarScan> fit, holdout;

@@ -39,6 +39,7 @@ struct DiagnoseArgs {
   bool fit_floor = false;
   bool no_cen2018_fit = false;
   std::string appearance_scene = "city";
+  std::string gain_chain;  // scene "combined": held gain chain from this sensor (file or name)
 };
 
 /// The appearance stage (no world or trajectory needed): findings, fitted sensor file, plots
@@ -60,6 +61,12 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   opt.fit_band_floor = a.fit_floor;
   opt.fit_cen2018 = !a.no_cen2018_fit;
   opt.scene = a.appearance_scene;
+  if (!a.gain_chain.empty()) {
+    if (opt.scene != "combined")
+      throw std::invalid_argument("--appearance-gain-chain needs --appearance-scene combined");
+    opt.gain_chain =
+        std::make_shared<const sim::SensorConfig>(sim::SensorConfig::loadNamed(a.gain_chain));
+  }
   const auto rep = diagnose::diagnoseAppearance(scans, s, physics, opt);
   const std::string dir = (fs::path(a.out) / "appearance").string();
   diagnose::writeAppearanceReport(rep, scans, diagnose::withReferenceScene(opt, scans), dir);
@@ -298,7 +305,13 @@ SPINRADAR_COMMAND(
                    "with --appearance-fit-floor on Oxford they measure the scene (docs/diagnose_cen2018.md)");
       app.add_option("--appearance-scene", a->appearance_scene,
                      "Reference scene of the appearance re-simulation: a built-in scene name, or "
-                     "'recording' (the recording's own fit-part returns as scatterers; issue 20)");
+                     "'recording' (the recording's own fit-part returns as scatterers; issue 20), "
+                     "or 'combined' (gain chain and beam from the city scene's fit, the rest "
+                     "against the recording's own scene; docs/diagnose_scene.md)");
+      app.add_option("--appearance-gain-chain", a->gain_chain,
+                     "With --appearance-scene combined: hold the gain chain and beam of this "
+                     "sensor (file or calibrated name, e.g. the city fit in config/sensors) "
+                     "instead of fitting them with the city scene first");
       app.add_option("--appearance-scans", a->appearance_scans,
                      "Re-simulated scans per evaluation in the appearance fit")
           ->capture_default_str();

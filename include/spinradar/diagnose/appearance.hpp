@@ -75,13 +75,22 @@ struct AppearanceLocate {
 
 struct AppearanceOptions {
   /// Reference scene of the re-simulation: a built-in scene name, or "recording": the
-  /// recording's own fit-part scans as scatterers (withReferenceScene, appearance_scene.cpp).
+  /// recording's own fit-part scans as scatterers (withReferenceScene, appearance_scene.cpp), or
+  /// "combined": the gain chain and beam from the city scene's fit, the rest with the recording's
+  /// own scene (combinedAppearance, appearance_combined.cpp).
   std::string scene = "city";
   /// "recording" scene: a return is a local maximum this far above its range bin's upper quartile
   /// (over the upper quartile; exponential speckle exceeds that in 1e-6 of the cells).
   double scene_margin_db = 10.0;
   /// "recording" scene: the scans it is taken from (set by withReferenceScene).
   std::shared_ptr<const std::vector<PolarScan>> scene_scans;
+  /// Hold the returns' gain chain and the beam (notIdentifiableWithOwnScene, and the return
+  /// level per range node of the range curves) at the start sensor's values: the second stage of
+  /// scene "combined" (appearance_combined.cpp), which sets it.
+  bool hold_gain_chain = false;
+  /// Scene "combined": the sensor whose gain chain and beam are held. Null: from a fit with the
+  /// city scene run first (the calibrated files in config/sensors are such fits).
+  std::shared_ptr<const sim::SensorConfig> gain_chain;
   int scans = 4;               ///< re-simulated scans per evaluation
   uint64_t seed = 11;
   int iterations = 4;          ///< Newton steps of the indirect-inference fit
@@ -167,6 +176,15 @@ AppearanceOptions withReferenceScene(const AppearanceOptions& opt,
 std::vector<PolarScan> renderRecordingScene(const sim::SensorConfig& sensor,
                                             const sim::PhysicsConfig& physics,
                                             const AppearanceOptions& opt, uint64_t seed);
+
+/// Scene "combined" (dispatched to by diagnoseAppearance): the returns' gain chain and the beam
+/// (what the recording's own scene absorbs) from the city scene's fit or opt.gain_chain, then
+/// everything else fitted against the recording's own scene with them held. Findings of the
+/// held parameters are the city fit's (or "held" when given).
+AppearanceReport combinedAppearance(const std::vector<PolarScan>& real,
+                                    const sim::SensorConfig& sensor,
+                                    const sim::PhysicsConfig& physics,
+                                    const AppearanceOptions& opt);
 
 /// The appearance stage on `real` against the base model `sensor` / `physics` (the geometry
 /// fields of `sensor`, bins, resolution, azimuths, must be the recording's).
