@@ -40,6 +40,7 @@ struct DiagnoseArgs {
   bool no_cen2018_fit = false;
   std::string appearance_scene = "city";
   std::string gain_chain;  // scene "combined": held gain chain from this sensor (file or name)
+  double scene_margin_db = 10.0;
 };
 
 /// The appearance stage (no world or trajectory needed): findings, fitted sensor file, plots
@@ -61,6 +62,7 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   opt.fit_band_floor = a.fit_floor;
   opt.fit_cen2018 = !a.no_cen2018_fit;
   opt.scene = a.appearance_scene;
+  opt.scene_margin_db = a.scene_margin_db;
   if (!a.gain_chain.empty()) {
     if (opt.scene != "combined")
       throw std::invalid_argument("--appearance-gain-chain needs --appearance-scene combined");
@@ -308,6 +310,11 @@ SPINRADAR_COMMAND(
                      "'recording' (the recording's own fit-part returns as scatterers; issue 20), "
                      "or 'combined' (gain chain and beam from the city scene's fit, the rest "
                      "against the recording's own scene; docs/diagnose_scene.md)");
+      app.add_option("--appearance-scene-margin", a->scene_margin_db,
+                     "With the recording's own scene: a return stands this far (dB) over its "
+                     "range bin's upper quartile")
+          ->check(CLI::Range(0.5, 59.0))
+          ->capture_default_str();
       app.add_option("--appearance-gain-chain", a->gain_chain,
                      "With --appearance-scene combined: hold the gain chain and beam of this "
                      "sensor (file or calibrated name, e.g. the city fit in config/sensors) "
