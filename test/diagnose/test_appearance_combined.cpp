@@ -70,7 +70,8 @@ TEST(AppearanceCombined, GainChainFromCityRestFromOwnScene) {
 
 // A given gain chain (a calibrated file) is held as it is: the city stage is not run, the
 // receiver gain, slope, beam and the returns' level per range node stay the file's, reported
-// "held (given)" and never named; the noise floor is still recovered.
+// "held (given)" and never named; the noise floor is still recovered. Held also where the
+// recording is far brighter than the given gain chain.
 TEST(AppearanceCombined, GivenGainChainIsHeldAsGiven) {
   sim::SensorConfig truth = testing::hundredMetreSensor();
   truth.noise_floor_db += 3;
@@ -92,6 +93,13 @@ TEST(AppearanceCombined, GivenGainChainIsHeldAsGiven) {
   EXPECT_FALSE(f->named);
   EXPECT_NEAR(rep.fitted.noise_floor_db, truth.noise_floor_db, 1.0);
   EXPECT_DOUBLE_EQ(rep.base.radar_constant_db, testing::hundredMetreSensor().radar_constant_db);
+  // A recording 30 dB brighter than the given gain chain: the level pre-alignment (which moves
+  // the receiver gain for gaps over 27 dB) leaves it as given too.
+  sim::SensorConfig bright = testing::hundredMetreSensor();
+  bright.radar_constant_db += 30;
+  const AppearanceReport rb =
+      diagnoseAppearance(outAndBack(bright), testing::hundredMetreSensor(), {}, opt);
+  EXPECT_DOUBLE_EQ(rb.fitted.radar_constant_db, given->radar_constant_db);
   opt.scene = "recording";  // a given gain chain is for the combined mode only
   EXPECT_THROW(combinedAppearance(outAndBack(truth), truth, {}, opt), std::invalid_argument);
 }
