@@ -41,6 +41,7 @@ struct DiagnoseArgs {
   std::string appearance_scene = "city";
   std::string gain_chain;  // scene "combined": held gain chain from this sensor (file or name)
   double scene_margin_db = 10.0;
+  bool fit_spread = false;
 };
 
 /// The appearance stage (no world or trajectory needed): findings, fitted sensor file, plots
@@ -63,6 +64,7 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   opt.fit_cen2018 = !a.no_cen2018_fit;
   opt.scene = a.appearance_scene;
   opt.scene_margin_db = a.scene_margin_db;
+  opt.fit_spread_bands = a.fit_spread;
   if (!a.gain_chain.empty()) {
     if (opt.scene != "combined")
       throw std::invalid_argument("--appearance-gain-chain needs --appearance-scene combined");
@@ -315,6 +317,9 @@ SPINRADAR_COMMAND(
                      "range bin's upper quartile")
           ->check(CLI::Range(0.5, 59.0))
           ->capture_default_str();
+      app.add_flag("--appearance-fit-spread", a->fit_spread,
+                   "Let the per-band figures move the range spread too (CA-CFAR cells follow the "
+                   "returns' width; docs/diagnose_scene.md)");
       app.add_option("--appearance-gain-chain", a->gain_chain,
                      "With --appearance-scene combined: hold the gain chain and beam of this "
                      "sensor (file or calibrated name, e.g. the city fit in config/sensors) "

@@ -117,6 +117,11 @@ struct AppearanceOptions {
   /// reference city scene cannot give Oxford's counts (a third at 10-25 m; scene content,
   /// docs/diagnose_cen2018.md) and they would pull every other figure off.
   bool fit_cen2018 = true;
+  /// Let the per-band figures move the range spread too (a global of the range-curve fit).
+  /// Off by default: on Boreas-RT's own scene it takes the fit part from 66 % to 9 % (the
+  /// CA-CFAR cells follow the returns' width) but the held-out worst gap goes 62 -> 77 %, and
+  /// combined on Oxford / MulRan gets worse (docs/diagnose_scene.md).
+  bool fit_spread_bands = false;
   /// Fit on part of the recording and check on the rest (splitHoldout).
   bool holdout = true;
 };
