@@ -119,8 +119,9 @@ struct AppearanceOptions {
   bool fit_cen2018 = true;
   /// Let the per-band figures move the range spread too (a global of the range-curve fit).
   /// Off by default: on Boreas-RT's own scene it takes the fit part from 66 % to 9 % (the
-  /// CA-CFAR cells follow the returns' width) but the held-out worst gap goes 62 -> 77 %, and
-  /// combined on Oxford / MulRan gets worse (docs/diagnose_scene.md).
+  /// CA-CFAR cells follow the returns' width; held out 62 -> 77 %, the quarters' own scatter) and
+  /// RADIATE's held out 23 -> 20 %, but Oxford's combined 14 -> 20 % and MulRan's 20 -> 25 %
+  /// (docs/diagnose_scene.md).
   bool fit_spread_bands = false;
   /// Fit on part of the recording and check on the rest (splitHoldout).
   bool holdout = true;
