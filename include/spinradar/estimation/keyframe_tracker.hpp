@@ -119,6 +119,11 @@ class KeyframeTracker {
   /// m, nearest-point re-association after a descriptor registration (keyframe_tracker.cpp)
   static constexpr double kReassociateGate = 0.3;
   static constexpr double kProximityMinAngle = 0.15;  ///< rad, keyframe-to-scan yaw for it
+  /// Where the descriptors fail even with kMinWeakInliers and the proximity fallback did not
+  /// run, the proximity ICP is tried last and kept when its pose's squared Mahalanobis
+  /// distance from the prediction (over [x, y, yaw], the prior's covariance) is under this:
+  /// chi-square, 3 degrees of freedom, 99 % (keyframe_tracker.cpp).
+  static constexpr double kLastResortChi2 = 11.34;
   /// The registration's own velocity moves the scan's frame and map when its yaw rate is
   /// this far (rad/s) from the pair velocity's, or the pair velocity's yaw rate changed by
   /// over kRampYawAccel (rad/s^2) in the last scan; the pair velocity otherwise. After a
