@@ -11,7 +11,8 @@
 
 namespace spinradar {
 
-KeyframeTracker::KeyframeTracker(const EstimatorConfig& config) : config_(config) {}
+KeyframeTracker::KeyframeTracker(const EstimatorConfig& config)
+    : config_(config), max_floor_(kTangentialFloor) {}
 
 void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_prev,
                             const Eigen::Matrix3d& P_prev, double nndr, MotionEstimate& pair,
