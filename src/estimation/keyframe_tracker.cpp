@@ -11,8 +11,7 @@
 
 namespace spinradar {
 
-KeyframeTracker::KeyframeTracker(const EstimatorConfig& config)
-    : config_(config), max_floor_(kTangentialFloor) {}
+KeyframeTracker::KeyframeTracker(const EstimatorConfig& config) : config_(config) {}
 
 void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_prev,
                             const Eigen::Matrix3d& P_prev, double nndr, MotionEstimate& pair,

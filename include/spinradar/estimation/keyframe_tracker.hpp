@@ -59,6 +59,7 @@
 #include "spinradar/core/feature_frame.hpp"
 #include "spinradar/features/matcher.hpp"
 #include "spinradar/estimation/direction_scales.hpp"
+#include "spinradar/estimation/mc_ransac.hpp"
 #include "spinradar/estimation/motion_estimate.hpp"
 #include "spinradar/core/params.hpp"
 
@@ -223,7 +224,7 @@ class KeyframeTracker {
   std::vector<double> key_tau_m_;  ///< the matched keyframe point's key_tau_
   std::vector<char> in_;
   DirectionScales<6> dirs_;  ///< per-direction residual scales of the solve (cov_acc)
-  double max_floor_;          ///< cap of the measured tangential floor (m)
+  double max_floor_ = kTangentialFloor;  ///< cap of the measured tangential floor (m)
   double last_floor_ = 0.0;   ///< the floor of the last solve (m)
   /// The next solve keeps last_floor_ (its matches are nearest-point pairs, see solve()).
   bool hold_floor_ = false;
