@@ -97,6 +97,7 @@ void KeyframeTracker::associateByProximity(const FeatureFrame& cur, const Eigen:
                                            const Eigen::Vector3d& xi, double c, double gate) {
   qx_.clear(); qy_.clear(); px_.clear(); py_.clear(); ux_.clear(); uy_.clear(); tau_.clear();
   key_tau_m_.clear();
+  hold_floor_ = true;  // nearest-point pairs within a gate: their spread is not the returns'
   const size_t n = cur.keypoints.size();
   if (qx_.capacity() < n) {  // rare: a scan with more keypoints than the keyframe's headroom
     for (auto* v : {&qx_, &qy_, &px_, &py_, &ux_, &uy_, &tau_, &key_tau_m_}) v->reserve(n + n / 2);

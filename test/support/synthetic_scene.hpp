@@ -29,6 +29,9 @@ struct SceneOptions {
   double visible_range = 150.0;
   double range_sigma = 0.0;        ///< m, Gaussian range noise
   double azimuth_sigma = 0.0;      ///< rad, Gaussian azimuth noise
+  /// m, Gaussian position noise across the beam at every range (a real return's scattering
+  /// centre on an extended object; issue 19's tangential floor)
+  double tangential_sigma = 0.0;
   bool quantize_azimuth = false;   ///< report the row's angle instead of the true bearing
   double beta = 0.0;               ///< s, injected Doppler shift: r_apparent = r - beta u
   int clutter = 0;                 ///< random keypoints per scan that match nothing
@@ -139,6 +142,7 @@ class SyntheticScene {
       double az = std::atan2(-q.y(), q.x());
       if (o_.quantize_azimuth) az = a * dphi;
       az += o_.azimuth_sigma * nr(rng_);
+      if (o_.tangential_sigma > 0.0) az += o_.tangential_sigma / r_true * nr(rng_);
       const Eigen::Vector3d v = velocityAt(t);
       const double u = v(0) * std::cos(az) - v(1) * std::sin(az);
       const double r = r_true - o_.beta * u + o_.range_sigma * nr(rng_);

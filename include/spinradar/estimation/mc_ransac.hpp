@@ -35,18 +35,23 @@ void setMotionFromVelocity(const Eigen::Vector3d& xi, const Eigen::Matrix3d& xi_
                            double dt_ref, MotionEstimate& out);
 
 /// Tangential position noise that does not shrink with range (m), used by the pair estimate
-/// of refined (and its MC-RANSAC start) and by the pair recovery. mc and mc_doppler keep the
-/// paper's R_cart (floor 0); so does the keyframe registration (see below). Issue 19: after
+/// of refined (and its MC-RANSAC start) and by the pair recovery, and the cap of the floor
+/// the keyframe registration measures from its own residuals (see below). mc and mc_doppler
+/// keep the paper's R_cart (floor 0). Issue 19: after
 /// the fit, real Oxford matches (azimuth peaks, 3 pairs) spread 0.16 m across the beam under
 /// 20 m, 3x the 0.054 m that azimuth_sigma gives at 12 m, and 0.13-0.20 m beyond (flat, not
 /// ~r): the scattering centre of a near extended object (car, wall, post) moves with the
 /// aspect angle, which near objects change fastest. Without a floor the near points'
 /// tangential residuals got 10-50x the weight of far ones' and carried the yaw (Oxford pair
 /// 1, same inliers and times: -0.133 deg with the paper's weights, +0.024 with unit weights).
-/// The keyframe registration is left out: there the floor shrank the points' information
-/// against the tuned pose and velocity priors, and a yaw-rate step inside a scan (0.7 deg)
-/// stayed in the chain (test_keyframe_tracker YawRateStepInsideAScanStaysOutOfTheChain,
-/// test_keyframe_row_smears).
+/// The keyframe registration does not take this value as it is: on scans without such
+/// scatter (the simulator's, the synthetic tests') a fixed floor took the near matches'
+/// information, which is what pins a registration's yaw rate (far matches only see the yaw
+/// rate relative to the keyframe map's): the registered yaw rate then followed the map's,
+/// was passed from keyframe to keyframe (-0.08 rad/s after a turn) and moved every published
+/// pose by c dw (0.5-0.7 deg, test_keyframe_tracker YawRateStepInsideAScanStaysOutOfTheChain),
+/// and proximity ICP on row arcs slowed until it stopped 0.4 deg short (test_keyframe_row_
+/// smears). So it measures the floor (KeyframeTracker::kFloorNearFraction) and caps it here.
 constexpr double kTangentialFloor = 0.2;
 
 /// Inverse of the Cartesian covariance R_cart = H R H^T of a point p = h(r, phi) with
