@@ -27,10 +27,10 @@ void appendGlint(const std::vector<PolarScan>& real, const sim::SensorConfig& cu
   std::snprintf(buf, sizeof buf,
                 "Glint: returns matched between consecutive scans spread %.3f m across the beam "
                 "(%.3f along; %d pairs), the model %.3f (%.3f) with glint %.3f m and %.3f (%.3f) "
-                "with %.3f +- %.3f m (%s); reference: %d consecutive scans of the city route.",
+                "with %.3f +- %.3f m (%s); reference: %d x %d consecutive scans of the city route.",
                 g.real.all.tangential, g.real.all.radial, g.real.pairs, g.before.all.tangential,
                 g.before.all.radial, g.base, g.after.all.tangential, g.after.all.radial, g.value,
-                g.stddev, g.verdict.c_str(), GlintOptions{}.scans);
+                g.stddev, g.verdict.c_str(), go.segments, go.scans);
   rep.notes.push_back(buf);
   rep.findings.push_back(f);
 }

@@ -40,11 +40,48 @@ MatchedSpread referenceSpread(const sim::SensorConfig& sensor, const sim::Physic
   sim::Scene sc = sim::builtinScene(opt.scene);
   sim::Simulator s(std::move(sc.world), std::move(sc.trajectory), sensor, physics, opt.seed);
   const int total = s.scanCount();
-  const int n = std::min(opt.scans, total);
-  const int first = std::max(0, total / 2 - n / 2);
-  std::vector<PolarScan> scans;
-  for (int i = first; i < first + n; ++i) scans.push_back(s.renderScan(i));
-  return measureMatchedSpread(scans, nullptr, opt.spread);
+  const int n = std::min(opt.scans, total), S = std::max(1, opt.segments);
+  std::vector<MatchedSpread> seg;
+  for (int k = 0; k < S; ++k) {
+    const int first = std::clamp(int((k + 0.5) * total / S) - n / 2, 0, total - n);
+    std::vector<PolarScan> scans;
+    for (int i = first; i < first + n; ++i) scans.push_back(s.renderScan(i));
+    seg.push_back(measureMatchedSpread(scans, nullptr, opt.spread));
+  }
+  // Average of the segments: matches-weighted per band; the pooled figure's standard error from
+  // the segments' scatter (or their own, if larger).
+  MatchedSpread out = seg.front();
+  auto merge = [&](auto get) {
+    SpreadBand m;
+    double w = 0, se2 = 0;
+    std::vector<double> t;
+    for (auto& x : seg) {
+      const SpreadBand& b = get(x);
+      if (!std::isfinite(b.tangential) || b.matches < 2) continue;
+      m.tangential += b.matches * b.tangential, m.radial += b.matches * b.radial;
+      se2 += b.tangential_se * b.tangential_se;
+      w += b.matches, m.matches += b.matches;
+      t.push_back(b.tangential);
+    }
+    if (w <= 0) return SpreadBand{NAN, NAN, NAN, NAN, 0};
+    m.tangential /= w, m.radial /= w;
+    double sd = 0;
+    if (t.size() >= 2) {
+      double mu = 0;
+      for (double x : t) mu += x;
+      mu /= t.size();
+      for (double x : t) sd += (x - mu) * (x - mu);
+      sd = std::sqrt(sd / (t.size() - 1));
+    }
+    m.tangential_se = std::max(std::sqrt(se2) / t.size(), sd / std::sqrt(double(t.size())));
+    m.radial_se = m.tangential_se;
+    return m;
+  };
+  for (int b = 0; b < 4; ++b) out.band[b] = merge([b](MatchedSpread& x) -> SpreadBand& { return x.band[b]; });
+  out.all = merge([](MatchedSpread& x) -> SpreadBand& { return x.all; });
+  out.pairs = 0;
+  for (auto& x : seg) out.pairs += x.pairs;
+  return out;
 }
 
 GlintFit fitGlint(const std::vector<PolarScan>& recording, const sim::SensorConfig& sensor,
@@ -73,7 +110,8 @@ GlintFit fitGlint(const std::vector<PolarScan>& recording, const sim::SensorConf
   const double s = f.real.all.tangential;
   f.value = inverse(f.grid, f.ref_spread, s);
   // Uncertainty: the recording's and the reference's standard errors through the local slope.
-  const double se = std::hypot(f.real.all.tangential_se, interp(f.grid, f.ref_se, f.value));
+  const double se = std::sqrt(std::pow(f.real.all.tangential_se, 2) + std::pow(opt.scene_sd, 2) +
+                              std::pow(interp(f.grid, f.ref_se, f.value), 2));
   const double lo = inverse(f.grid, f.ref_spread, s - se), hi = inverse(f.grid, f.ref_spread, s + se);
   f.stddev = std::max(0.5 * (hi - lo), 1e-4);
   if (f.value <= 0) f.stddev = std::max(hi, 1e-4);  // one-sided: below the glint-free model
