@@ -7,6 +7,7 @@
 
 #include "cli_checks.hpp"
 #include "command.hpp"
+#include "spinradar/diagnose/glint_fit.hpp"
 #include "spinradar/diagnose/matched_spread.hpp"
 #include "spinradar/io/scan_folder.hpp"
 #include "spinradar/sim/realism.hpp"
@@ -25,6 +26,7 @@ struct SpreadCmdOptions {
   uint64_t seed = 1;
   double glint = -1;  // overrides the physics' glint when >= 0
   bool no_real = false;
+  bool fit = false;
   spinradar::diagnose::SpreadOptions spread;
 };
 
@@ -51,12 +53,16 @@ void runSpread(const SpreadCmdOptions& o) {
   const SensorConfig sensor = o.sensor.empty() ? SensorConfig{} : SensorConfig::loadNamed(o.sensor);
   std::printf("| data | pairs | returns/scan | 2.5-10 m tan / rad (n) | 10-25 m | 25-50 m | "
               "50-100 m | all: tan +- se / rad |\n|---|---|---|---|---|---|---|---|\n");
+  std::vector<std::pair<std::string, std::vector<PolarScan>>> fits;
   if (!o.no_real) {
     if (!std::filesystem::is_directory(o.realdata))
       throw std::runtime_error(o.realdata + ": no such folder of real samples (--realdata; "
                                "--no-real for simulations only)");
     for (auto& [name, scans] : loadRealSamples(o.realdata))
-      if (scans.size() >= 2) printRow(name, diagnose::measureMatchedSpread(scans, nullptr, o.spread));
+      if (scans.size() >= 2) {
+        printRow(name, diagnose::measureMatchedSpread(scans, nullptr, o.spread));
+        if (o.fit) fits.emplace_back(name, scans);
+      }
   }
   for (const auto& dir : o.recordings) {
     ScanFolder folder(dir);
@@ -64,6 +70,7 @@ void runSpread(const SpreadCmdOptions& o) {
     for (size_t i = 0; i < std::min<size_t>(folder.size(), size_t(o.scans)); ++i)
       scans.push_back(folder.load(i));
     printRow(dir, diagnose::measureMatchedSpread(scans, nullptr, o.spread));
+    if (o.fit) fits.emplace_back(dir, scans);
   }
   for (const auto& name : o.scenes) {
     Scene sc = builtinScene(name);
@@ -74,6 +81,15 @@ void runSpread(const SpreadCmdOptions& o) {
       scans.push_back(sim.renderScan(i));
     printRow(name + " (sim" + (o.sensor.empty() ? "" : ", " + o.sensor) + ")",
              diagnose::measureMatchedSpread(scans, nullptr, o.spread));
+  }
+  for (const auto& [name, scans] : fits) {
+    // Against the model without glint (the glint of --physics/--glint is the base).
+    diagnose::GlintOptions go;
+    go.spread = o.spread;
+    const auto g = diagnose::fitGlint(scans, sensor, physics, go);
+    std::printf("\n%s: glint %.3f +- %.3f m (z %.1f, %s) against the sensor model%s\n%s", name.c_str(),
+                g.value, g.stddev, g.z, g.verdict.c_str(),
+                o.sensor.empty() ? "" : (" " + o.sensor).c_str(), diagnose::glintTable(g).c_str());
   }
   std::cout << "\nRobust std (1.4826 MAD) of the difference of mutually nearest returns of "
                "consecutive scans after alignment, m: across the beam / along it (matches).\n";
@@ -105,6 +121,9 @@ SPINRADAR_COMMAND("spread", "Spread of returns matched between consecutive scans
                     app.add_option("--gate", o->spread.gate, "Matching gate, m")
                         ->capture_default_str()
                         ->check(CLI::Range(0.1, 5.0));
+                    app.add_flag("--fit", o->fit,
+                                 "Fit the glint of the real samples and --recording folders "
+                                 "(reference: the city route with --sensor)");
                     app.add_flag("--no-real", o->no_real, "Simulations (and --recording folders) only");
                     app.callback([o] { runSpread(*o); });
                   });
