@@ -91,6 +91,16 @@ double robustStd(std::vector<double> v) {
 // Standard error of the MAD-based std of n normal samples (asymptotic efficiency 0.37).
 double madSe(double s, size_t n) { return n > 1 ? 1.167 * s / std::sqrt(double(n)) : NAN; }
 
+// Scan b follows scan a directly: later, and by at most 1.6 rotations when the row stamps give
+// the rotation time (scans spread over a route, or masked copies of one scan, are no pair).
+bool consecutive(const PolarScan& a, const PolarScan& b) {
+  const int64_t gap = b.firstStamp() - a.firstStamp();
+  if (gap <= 0) return false;
+  const int64_t span = a.lastStamp() - a.firstStamp();
+  if (span <= 0 || a.azimuths < 2) return true;
+  return double(gap) <= 1.6 * double(span) * a.azimuths / (a.azimuths - 1);
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector2d> spreadReturns(const PolarScan& scan, const SpreadOptions& opt) {
@@ -234,7 +244,7 @@ MatchedSpread measureMatchedSpread(const std::vector<PolarScan>& scans,
   std::vector<double> all_t, all_r;
   Eigen::Matrix3d prev = Eigen::Matrix3d::Identity();
   for (size_t i = 0; i + 1 < scans.size(); ++i) {
-    if (scans[i].firstStamp() == scans[i + 1].firstStamp()) continue;  // masked copies
+    if (!consecutive(scans[i], scans[i + 1])) continue;
     const auto &a = ret[i], &b = ret[i + 1];
     const Eigen::Matrix3d T = motions ? (*motions)[i] : alignReturns(a, b, prev, opt);
     prev = T;

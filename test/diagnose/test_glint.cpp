@@ -130,6 +130,12 @@ TEST(GlintFit, ConcealedGlintNamedAndFittedNullNamesNothing) {
   // One scan (or masked copies of one) is no pair: not identifiable.
   const auto one = recording(0, 300, 1);
   EXPECT_EQ(fitGlint({one[0], one[0]}, sim::SensorConfig{}, drive(0)).verdict, "not identifiable");
+  // Scans spread over the route (every 40th, as the appearance reference renders) are no pairs.
+  sim::Scene sc = sim::builtinScene("out_and_back");
+  sim::Simulator s(std::move(sc.world), std::move(sc.trajectory), sim::SensorConfig{}, drive(0.3), 7);
+  const std::vector<PolarScan> spread = {s.renderScan(100), s.renderScan(140), s.renderScan(180)};
+  EXPECT_EQ(measureMatchedSpread(spread).pairs, 0);
+  EXPECT_FALSE(fitGlint(spread, sim::SensorConfig{}, drive(0)).named);
 }
 
 }  // namespace

@@ -47,7 +47,8 @@ std::vector<Eigen::Vector2d> spreadReturns(const PolarScan& scan, const SpreadOp
 
 /// Spread of the returns matched between scans i and i+1. `motions`, when not null, holds the
 /// pose of scan i+1 in the frame of scan i for each pair (size scans - 1); otherwise it is
-/// estimated. Scans whose first stamps are equal (masked copies of one scan) are not a pair.
+/// estimated. Only consecutive scans are a pair: later, by at most 1.6 rotations when the row
+/// stamps span the rotation (not masked copies of one scan, not scans spread over a route).
 MatchedSpread measureMatchedSpread(const std::vector<PolarScan>& scans,
                                    const std::vector<Eigen::Matrix3d>* motions = nullptr,
                                    const SpreadOptions& opt = {});
