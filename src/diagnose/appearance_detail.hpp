@@ -78,4 +78,9 @@ AppearanceFinding fitCodeSet(const std::vector<PolarScan>& real, const Appearanc
 void markOwnSceneFindings(std::vector<AppearanceFinding>& findings,
                           std::vector<std::string>& notes);
 
+/// Glint (physics "glint", glint_fit.hpp) of the consecutive scans `real` against cur/phys: its
+/// finding and a note with the spread before/after go to `rep`; sets it in `phys` when named.
+void appendGlint(const std::vector<PolarScan>& real, const sim::SensorConfig& cur,
+                 sim::PhysicsConfig& phys, const AppearanceOptions& opt, AppearanceReport& rep);
+
 }  // namespace spinradar::diagnose::detail

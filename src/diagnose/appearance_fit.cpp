@@ -12,6 +12,7 @@
 
 #include "appearance_detail.hpp"
 #include "markdown_table.hpp"
+#include "spinradar/diagnose/glint_fit.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
 
@@ -380,6 +381,7 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
       rep.after = figuresOf(cur, phys);
     }
   }
+  if (opt.fit_glint) detail::appendGlint(real, cur, phys, opt, rep);  // appearance_glint.cpp
   if (opt.scene == "recording" && !opt.hold_gain_chain) detail::markOwnSceneFindings(rep.findings, rep.notes);
   std::stable_sort(rep.findings.begin(), rep.findings.end(),
                    [](const AppearanceFinding& a, const AppearanceFinding& b) {

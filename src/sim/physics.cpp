@@ -60,6 +60,8 @@ void checkExtra(const std::string& key, const nlohmann::json& v) {
     num(v, k, 0.0, 1000.0);
   } else if (key == "encoder_wobble") {
     num(v, k, -0.1, 0.1);
+  } else if (key == "glint") {
+    num(v, k, 0.0, 5.0);
   } else if (key == "chirp_alternate") {
     flag(v, k);
   } else if (key == "scan_pose_time") {
@@ -70,7 +72,7 @@ void checkExtra(const std::string& key, const nlohmann::json& v) {
                         "unknown effect (expected motion_distortion, doppler, timestamp_offset, "
                         "azimuth_offset, range_offset, moving_objects, stamp_bursts, "
                         "rotation_jitter, multipath, attenuation, encoder_wobble, "
-                        "chirp_alternate, scan_pose_time)");
+                        "chirp_alternate, scan_pose_time, glint)");
   }
 }
 

@@ -37,6 +37,7 @@ ExtraEffects ExtraEffects::from(const PhysicsConfig& p) {
   if (on("rotation_jitter")) e.rotation_jitter = x["rotation_jitter"].get<double>();
   if (on("encoder_wobble")) e.encoder_wobble = x["encoder_wobble"].get<double>();
   if (on("chirp_alternate")) e.chirp_alternate = true;
+  if (on("glint")) e.glint = x["glint"].get<double>();
   if (on("attenuation")) e.attenuation_db_per_km = x["attenuation"].get<double>();
   if (on("multipath")) {
     e.multipath = true;

@@ -36,6 +36,7 @@ struct ExtraEffects {
   bool multipath = false;
   double multipath_db = -15.0;    ///< ghost power relative to the direct return
   bool pose_at_start = false;     ///< motion_distortion off: pose of scan start, not middle
+  double glint = 0.0;             ///< m, per-scan std of the scattering-centre shift
 
   static ExtraEffects from(const PhysicsConfig& p);
 };

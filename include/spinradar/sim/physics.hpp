@@ -13,6 +13,9 @@
 //   "attenuation": dB/km   two-way path loss (rain, fog)
 //   "chirp_alternate": true  Boreas-RT style: Doppler sign flips on alternate azimuths
 //   "scan_pose_time": "mid" | "start"  pose used when motion_distortion is off
+//   "glint": m   per-axis std of a per-scan isotropic random shift of every scatterer's
+//       scattering centre (where on an extended object the return comes from changes with the
+//       aspect; real Oxford ~0.1 m, `spinradar spread`); 0 = off, the default
 #include <string>
 #include <vector>
 
