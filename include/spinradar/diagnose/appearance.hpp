@@ -82,6 +82,11 @@ struct AppearanceOptions {
   /// "recording" scene: a return is a local maximum this far above its range bin's upper quartile
   /// (over the upper quartile; exponential speckle exceeds that in 1e-6 of the cells).
   double scene_margin_db = 10.0;
+  /// "recording" scene built by deconvolution (CLEAN, appearance_scene_clean.cpp): the strongest
+  /// remaining return becomes a scatterer and the model's point response (range spread x beam)
+  /// is taken off, until the residual is under the margin, so an extended return (a wall, a
+  /// bush) becomes several scatterers. Off: one scatterer per local maximum along each row.
+  bool scene_clean = true;
   /// "recording" scene: the scans it is taken from (set by withReferenceScene).
   std::shared_ptr<const std::vector<PolarScan>> scene_scans;
   /// Hold the returns' gain chain and the beam (notIdentifiableWithOwnScene, and the return
