@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "appearance_detail.hpp"
+#include "appearance_scene_detail.hpp"
 #include "spinradar/diagnose/appearance.hpp"
 #include "spinradar/sim/simulator.hpp"
 
@@ -27,7 +28,7 @@ namespace spinradar::diagnose {
 
 using sim::SensorConfig;
 
-namespace {
+namespace scene_detail {
 
 // Count -> received power in dB, the inverse of the quantiser (render_model.cpp): counts are
 // power_scale per dB, compressed above the knee by compression_ratio.
@@ -91,7 +92,18 @@ std::vector<double> beamProfile(const SensorConfig& sensor) {
   return k;
 }
 
-}  // namespace
+double beamAt(const std::vector<double>& kern, double x) {
+  const int span = int(kern.size()) - 1;
+  x = std::abs(x);
+  const int d = int(x);
+  if (d >= span) return d == span && x == span ? kern[size_t(span)] : 0.0;
+  return std::exp(std::log(kern[size_t(d)]) +
+                  (x - d) * (std::log(kern[size_t(d) + 1]) - std::log(kern[size_t(d)])));
+}
+
+}  // namespace scene_detail
+
+using namespace scene_detail;
 
 sim::World recordingWorld(const PolarScan& scan, const SensorConfig& s,
                           const AppearanceOptions& opt) {
@@ -143,6 +155,13 @@ sim::World recordingWorld(const PolarScan& scan, const SensorConfig& s,
   std::nth_element(spread.begin(), spread.begin() + nb / 2, spread.end());
   const double per_db =
       distinct >= 27 ? std::max(s.power_scale, spread[size_t(nb / 2)] / 6.8) : s.power_scale;
+  if (opt.scene_clean) {  // deconvolution in range and azimuth (appearance_scene_clean.cpp)
+    sim::World w = cleanWorld(scan, s, src, floor_q, per_db, opt);
+    if (std::getenv("SPINRADAR_APPEARANCE_VERBOSE"))
+      std::cerr << "recording scene (CLEAN): codes 1-30 " << distinct << ", counts/dB " << per_db
+                << ", scatterers " << w.targets.size() << "\n";
+    return w;
+  }
 
   // A return is a local maximum along its row within the range mainlobe (2 sigma either side).
   // Along azimuth every row keeps its own: an extended object (a wall, a car) spans rows, and
@@ -177,12 +196,7 @@ sim::World recordingWorld(const PolarScan& scan, const SensorConfig& s,
   // (beamProfile).
   const std::vector<double> kern = beamProfile(s);
   const int span = int(kern.size()) - 1;
-  auto K = [&](double x) {  // the profile between its rows, log-linear; 0 beyond it
-    x = std::abs(x);
-    const int d = int(x);
-    if (d >= span) return d == span && x == span ? kern[span] : 0.0;
-    return std::exp(std::log(kern[d]) + (x - d) * (std::log(kern[d + 1]) - std::log(kern[d])));
-  };
+  auto K = [&](double x) { return beamAt(kern, x); };  // log-linear between rows; 0 beyond
   auto neighbour = [&](int r, int b) {
     for (int bb = std::max(0, b - 1); bb <= std::min(nb - 1, b + 1); ++bb)
       if (index[size_t(r) * nb + bb] >= 0) return index[size_t(r) * nb + bb];

@@ -41,6 +41,7 @@ struct DiagnoseArgs {
   std::string appearance_scene = "city";
   std::string gain_chain;  // scene "combined": held gain chain from this sensor (file or name)
   double scene_margin_db = 10.0;
+  bool scene_clean = false;  // own scene by CLEAN instead of one scatterer per local maximum
   bool fit_spread = false;
 };
 
@@ -64,6 +65,7 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   opt.fit_cen2018 = !a.no_cen2018_fit;
   opt.scene = a.appearance_scene;
   opt.scene_margin_db = a.scene_margin_db;
+  opt.scene_clean = a.scene_clean;
   opt.fit_spread_bands = a.fit_spread;
   if (!a.gain_chain.empty()) {
     if (opt.scene != "combined")
@@ -317,6 +319,10 @@ SPINRADAR_COMMAND(
                      "range bin's upper quartile")
           ->check(CLI::Range(0.5, 59.0))
           ->capture_default_str();
+      app.add_flag("--appearance-scene-clean", a->scene_clean,
+                   "With the recording's own scene: build it by CLEAN deconvolution (extended "
+                   "returns become several scatterers and keep their width) instead of one "
+                   "scatterer per local maximum along each row (docs/diagnose_scene.md)");
       app.add_flag("--appearance-fit-spread", a->fit_spread,
                    "Let the per-band figures move the range spread too (CA-CFAR cells follow the "
                    "returns' width; docs/diagnose_scene.md)");
