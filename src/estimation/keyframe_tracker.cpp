@@ -19,7 +19,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   const double dt = has_last_stamp_ ? 1e-9 * static_cast<double>(cur.stamp_ns - last_stamp_) : 0.25;
   last_stamp_ = cur.stamp_ns;
   has_last_stamp_ = true;
-  const double c = kMidScan * dt;  // this scan's reference: mid-scan
+  const double c = kMidScan * scan_period_.update(cur, dt);  // mid-scan, see ScanPeriod
   // The pair velocity's yaw rate changed by over kRampYawAccel in the last scan (a ramp).
   const bool pair_ramp = std::abs(pair.velocity(2) - prev_pair_xi_(2)) > kRampYawAccel * dt;
   row_step_ = rowQuantization(cur);

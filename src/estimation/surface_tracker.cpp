@@ -124,7 +124,7 @@ bool SurfaceTracker::track(const FeatureFrame& cur, const Eigen::Vector3d& veloc
   const double dt = has_last_ ? 1e-9 * static_cast<double>(cur.stamp_ns - last_stamp_) : 0.25;
   last_stamp_ = cur.stamp_ns;
   has_last_ = true;
-  const double c = kMidScan * dt;
+  const double c = kMidScan * scan_period_.update(cur, dt);  // mid-scan, see ScanPeriod
   // The scan's returns as a static picture at mid-scan: Doppler and motion compensated.
   const size_t n = cur.keypoints.size();
   if (corrected_.capacity() < n) {

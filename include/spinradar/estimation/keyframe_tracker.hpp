@@ -58,6 +58,7 @@
 
 #include "spinradar/core/feature_frame.hpp"
 #include "spinradar/features/matcher.hpp"
+#include "spinradar/estimation/scan_period.hpp"
 #include "spinradar/estimation/direction_scales.hpp"
 #include "spinradar/estimation/mc_ransac.hpp"
 #include "spinradar/estimation/motion_estimate.hpp"
@@ -175,6 +176,7 @@ class KeyframeTracker {
   static constexpr int kFloorIterations = 4;
 
  private:
+  ScanPeriod scan_period_;  ///< the rotation period, for the mid-scan reference (gaps)
   /// f becomes the keyframe: T_w, P its (published) scan-start pose and covariance, xi its
   /// velocity, c (s) the time after f.stamp_ns of its reference (mid-scan) frame.
   void makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d& xi, double c,

@@ -21,6 +21,7 @@
 
 #include "spinradar/core/feature_frame.hpp"
 #include "spinradar/core/params.hpp"
+#include "spinradar/estimation/scan_period.hpp"
 #include "spinradar/estimation/surface_points.hpp"
 
 namespace spinradar {
@@ -61,6 +62,7 @@ class SurfaceTracker {
   static constexpr double kCovInflation = 4.0;  ///< published covariance (see the .cpp)
 
  private:
+  ScanPeriod scan_period_;  ///< the rotation period, for the mid-scan reference (gaps)
   bool solve(const Eigen::Matrix3d& T_pred, const Eigen::Matrix3d& W_prior, Eigen::Matrix3d& T,
              Eigen::Matrix3d& cov);
   void addKeyframe(const Eigen::Matrix3d& T_w_mid, int64_t stamp, const Eigen::Matrix3d& T_w,
