@@ -74,7 +74,22 @@ cols_spec=(
   "out_and_back_v2|out_and_back|2|{}|1|no"
   "city_v5_narrow_beam2.4|city|5|{\"range_psf_sigma_bins\": 0.64, \"beam_width_deg\": 2.4}|1|yes"
   "out_and_back|out_and_back|0|{}|1|yes"
+  # Glint (physics "glint", m: each scan moves every scattering centre by that much per axis):
+  # real returns matched between scans spread 0.15-0.25 m across the beam, the simulator's
+  # without glint 0.05-0.07 m (docs/diagnose_glint.md; fitted Oxford 0.09-0.14, RADIATE 0.18).
+  "city_glint0.14|city|0|{}|1|no|\"glint\": 0.14"
+  "city_oxford_glint0.14|city|0|@oxford|1|no|\"glint\": 0.14"
+  "out_and_back_glint0.18|out_and_back|0|{}|1|yes|\"glint\": 0.18"
 )
+# "@name": the calibrated model config/sensors/name.json.
+for i in "${!cols_spec[@]}"; do
+  IFS='|' read -r _ _ _ sensor _ _ _ <<< "${cols_spec[$i]}"
+  if [[ "$sensor" == @* ]]; then
+    f="$root/config/sensors/${sensor#@}.json"
+    [[ -f "$f" ]] || { echo "error: $f not found (column ${cols_spec[$i]%%|*})" >&2; exit 1; }
+    cols_spec[$i]="${cols_spec[$i]/|$sensor|/|$(tr -d '\n' < "$f")|}"
+  fi
+done
 for f in "$root"/config/sensors/*.json; do
   [[ -f "$f" ]] || continue
   cols_spec+=("city_$(basename "$f" .json)|city|0|$(tr -d '\n' < "$f")|1|no")
@@ -116,14 +131,18 @@ print(f"clutter x{factor}: {len(extra)} scatterers added", file=sys.stderr)
 PY
 }
 
-simulate_column() {  # label scene variant sensor clutter
-  local label="$1" scene="$2" variant="$3" sensor="$4" clutter="$5"
-  local rec="$out/rec_$label"
-  local stamp="scene=$scene variant=$variant seed=$seed scans=$scans clutter=$clutter sensor=$sensor physics=$(tr -d ' \n' < "$out/physics_full.json")"
+simulate_column() {  # label scene variant sensor clutter [extra physics, JSON members]
+  local label="$1" scene="$2" variant="$3" sensor="$4" clutter="$5" extra="${6:-}"
+  local rec="$out/rec_$label" physics="$out/physics_full.json"
+  if [[ -n "$extra" ]]; then
+    physics="$out/physics_$label.json"
+    sed "s/}\s*$/, $extra}/" "$out/physics_full.json" > "$physics"
+  fi
+  local stamp="scene=$scene variant=$variant seed=$seed scans=$scans clutter=$clutter sensor=$sensor physics=$(tr -d ' \n' < "$physics")"
   if [[ -f "$rec/.spinradar_matrix" && "$(cat "$rec/.spinradar_matrix")" == "$stamp" ]]; then return; fi
   rm -rf "$rec"
   echo "$sensor" > "$out/sensor_$label.json"
-  local args=(simulate --physics "$out/physics_full.json" --sensor "$out/sensor_$label.json"
+  local args=(simulate --physics "$physics" --sensor "$out/sensor_$label.json"
               --seed "$seed" --scans "$scans" --out "$rec")
   if [[ "$clutter" != 1 ]]; then
     # The built-in scene's world and route, written once, then the clutter multiplied.
@@ -146,7 +165,7 @@ results="$out/results.tsv"
 [[ -n "${TABLE_ONLY:-}" ]] && cols_spec=()
 [[ -n "${TABLE_ONLY:-}" ]] || : > "$results"
 for spec in "${cols_spec[@]}"; do
-  IFS='|' read -r label scene variant sensor clutter held <<< "$spec"
+  IFS='|' read -r label scene variant sensor clutter held extra <<< "$spec"
   if [[ -n "${COLS:-}" && " $COLS " != *" $label "* ]]; then continue; fi
   if [[ "$scene" == "radiate" ]]; then
     seq="$shared/realdata/radiate_fog_6_0"
@@ -209,7 +228,7 @@ PY
     done
     continue
   fi
-  simulate_column "$label" "$scene" "$variant" "$sensor" "$clutter"
+  simulate_column "$label" "$scene" "$variant" "$sensor" "$clutter" "$extra"
   rec="$out/rec_$label"
   # The recording's bin size (a calibrated sensor model may not have Oxford's 0.0438 m, which
   # odometry assumes for Oxford-layout PNGs: RADIATE's 0.174 m read as 0.0438 gave 60 % drift).
