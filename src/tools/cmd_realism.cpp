@@ -4,6 +4,7 @@
 
 #include "cli_checks.hpp"
 #include "command.hpp"
+#include "scene_comparison_options.hpp"
 #include "spinradar/io/scan_folder.hpp"
 #include "spinradar/sim/realism.hpp"
 #include "spinradar/sim/scenes.hpp"
@@ -11,16 +12,12 @@
 
 namespace {
 
-struct RealismCmdOptions {
-  std::string realdata = "../shared/realdata";
-  std::vector<std::string> scenes{"city", "out_and_back", "tight_turns"};
-  std::vector<std::string> recordings;
-  std::string physics, sensor;
+struct RealismCmdOptions : spinradar::cli::SceneComparisonOptions {
+  RealismCmdOptions() { scenes = {"city", "out_and_back", "tight_turns"}; }
   int scans = 8;
   uint64_t seed = 1;
   double min_range = 2.5, max_range = 100.0;
   bool no_detect = false;
-  bool no_real = false;
 };
 
 void runRealism(const RealismCmdOptions& o) {
@@ -87,13 +84,7 @@ void runRealism(const RealismCmdOptions& o) {
 SPINRADAR_COMMAND("realism", "Compare simulated scans with the real samples (histogram, texture, detections)",
                   [](CLI::App& app) {
                     auto o = std::make_shared<RealismCmdOptions>();
-                    app.add_option("--realdata", o->realdata, "Folder of real samples")
-                        ->capture_default_str();
-                    app.add_option("--scene", o->scenes, "Built-in scenes to simulate")
-                        ->capture_default_str();
-                    app.add_option("--recording", o->recordings, "Extra recording folders");
-                    app.add_option("--physics", o->physics, "Physics JSON (default: distortion, Doppler, movers)");
-                    app.add_option("--sensor", o->sensor, "Sensor: JSON file or calibrated name (oxford, mulran, boreas_rt, radiate)");
+                    spinradar::cli::addSceneComparisonOptions(app, *o);
                     app.add_option("--scans", o->scans, "Scans per simulated scene")
                         ->capture_default_str()
                         ->check(spinradar::cli::atLeast(1));
@@ -104,8 +95,6 @@ SPINRADAR_COMMAND("realism", "Compare simulated scans with the real samples (his
                     app.add_option("--max-range", o->max_range, "m")
                         ->capture_default_str()
                         ->check(spinradar::cli::positive());
-                    app.add_flag("--no-real", o->no_real,
-                                 "Compare simulations (and --recording folders) only");
                     app.add_flag("--no-detect", o->no_detect, "Skip the detectors");
                     app.callback([o] { runRealism(*o); });
                   });

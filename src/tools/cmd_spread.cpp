@@ -7,6 +7,7 @@
 
 #include "cli_checks.hpp"
 #include "command.hpp"
+#include "scene_comparison_options.hpp"
 #include "spinradar/diagnose/glint_fit.hpp"
 #include "spinradar/diagnose/matched_spread.hpp"
 #include "spinradar/io/scan_folder.hpp"
@@ -16,16 +17,12 @@
 
 namespace {
 
-struct SpreadCmdOptions {
-  std::string realdata = "../shared/realdata";
-  std::vector<std::string> scenes{"city"};
-  std::vector<std::string> recordings;
-  std::string physics, sensor;
+struct SpreadCmdOptions : spinradar::cli::SceneComparisonOptions {
+  SpreadCmdOptions() { scenes = {"city"}; }
   int scans = 8;
   int start = -1;  // first simulated scan (-1: middle of the route)
   uint64_t seed = 1;
   double glint = -1;  // overrides the physics' glint when >= 0
-  bool no_real = false;
   bool fit = false;
   spinradar::diagnose::SpreadOptions spread;
 };
@@ -100,13 +97,7 @@ void runSpread(const SpreadCmdOptions& o) {
 SPINRADAR_COMMAND("spread", "Spread of returns matched between consecutive scans, across and along the beam per range band",
                   [](CLI::App& app) {
                     auto o = std::make_shared<SpreadCmdOptions>();
-                    app.add_option("--realdata", o->realdata, "Folder of real samples")
-                        ->capture_default_str();
-                    app.add_option("--scene", o->scenes, "Built-in scenes to simulate")
-                        ->capture_default_str();
-                    app.add_option("--recording", o->recordings, "Extra recording folders");
-                    app.add_option("--physics", o->physics, "Physics JSON (default: distortion, Doppler, movers)");
-                    app.add_option("--sensor", o->sensor, "Sensor: JSON file or calibrated name");
+                    spinradar::cli::addSceneComparisonOptions(app, *o);
                     app.add_option("--glint", o->glint, "Physics glint (m) of the simulated scenes")
                         ->check(spinradar::cli::atLeast(0));
                     app.add_option("--scans", o->scans, "Consecutive scans per scene or recording")
@@ -124,6 +115,5 @@ SPINRADAR_COMMAND("spread", "Spread of returns matched between consecutive scans
                     app.add_flag("--fit", o->fit,
                                  "Fit the glint of the real samples and --recording folders "
                                  "(reference: the city route with --sensor)");
-                    app.add_flag("--no-real", o->no_real, "Simulations (and --recording folders) only");
                     app.callback([o] { runSpread(*o); });
                   });
