@@ -37,14 +37,7 @@ void runRealism(const RealismCmdOptions& o) {
   ro.max_range = o.max_range;
   ro.detect = !o.no_detect;
   std::vector<RealismStats> cols;
-  PhysicsConfig physics;
-  if (o.physics.empty()) {
-    physics.moving_objects = true;
-    physics.motion_distortion = true;
-    physics.doppler = 0.049;
-  } else {
-    physics = PhysicsConfig::load(o.physics);
-  }
+  PhysicsConfig physics = cli::comparisonPhysics(o);
   SensorConfig sensor = o.sensor.empty() ? SensorConfig{} : SensorConfig::loadNamed(o.sensor);
   // The real samples are read first: a missing or corrupt one stops the command before the
   // (slow) simulations.

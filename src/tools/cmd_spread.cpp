@@ -37,14 +37,7 @@ void printRow(const std::string& name, const spinradar::diagnose::MatchedSpread&
 void runSpread(const SpreadCmdOptions& o) {
   using namespace spinradar;
   using namespace spinradar::sim;
-  PhysicsConfig physics;
-  if (o.physics.empty()) {
-    physics.moving_objects = true;
-    physics.motion_distortion = true;
-    physics.doppler = 0.049;
-  } else {
-    physics = PhysicsConfig::load(o.physics);
-  }
+  PhysicsConfig physics = cli::comparisonPhysics(o);
   if (o.glint >= 0) physics.extra["glint"] = o.glint;
   physics = PhysicsConfig::fromJson(physics.toJson());  // range checks
   const SensorConfig sensor = o.sensor.empty() ? SensorConfig{} : SensorConfig::loadNamed(o.sensor);

@@ -6,6 +6,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "spinradar/sim/physics.hpp"
+
 namespace spinradar::cli {
 
 struct SceneComparisonOptions {
@@ -24,6 +26,17 @@ inline void addSceneComparisonOptions(CLI::App& app, SceneComparisonOptions& o) 
   app.add_option("--sensor", o.sensor,
                  "Sensor: JSON file or calibrated name (oxford, mulran, boreas_rt, radiate)");
   app.add_flag("--no-real", o.no_real, "Compare simulations (and --recording folders) only");
+}
+
+/// The physics the scenes are simulated under: --physics, else motion distortion, Doppler
+/// (beta 0.049 s) and moving objects, as the recordings the real samples are compared with.
+inline sim::PhysicsConfig comparisonPhysics(const SceneComparisonOptions& o) {
+  if (!o.physics.empty()) return sim::PhysicsConfig::load(o.physics);
+  sim::PhysicsConfig physics;
+  physics.moving_objects = true;
+  physics.motion_distortion = true;
+  physics.doppler = 0.049;
+  return physics;
 }
 
 }  // namespace spinradar::cli
