@@ -10,6 +10,7 @@
 #include <Eigen/LU>
 
 #include "spinradar/core/lie.hpp"
+#include "spinradar/core/normal_equations.hpp"
 #include "spinradar/estimation/mc_ransac.hpp"
 
 namespace spinradar {
@@ -118,10 +119,8 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
       ++cnt;
     }
     if (cnt < min_inliers_) return false;
-    Eigen::LDLT<Mat6> ldlt(A);
-    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
-    const Vec6 dx = ldlt.solve(b);
-    if (!dx.allFinite()) return false;
+    Vec6 dx;
+    if (!solveNormalEquations(A, b, dx)) return false;
     T = se2::exp(dx.head<3>()) * T;
     xi += dx.tail<3>();
     const bool settled = it >= 3 && dx.head<2>().norm() < 1e-5 && std::abs(dx(2)) < 1e-7;

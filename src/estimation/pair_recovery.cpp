@@ -7,6 +7,7 @@
 #include <Eigen/LU>
 
 #include "spinradar/core/lie.hpp"
+#include "spinradar/core/normal_equations.hpp"
 #include "spinradar/estimation/mc_ransac.hpp"
 
 namespace spinradar {
@@ -221,10 +222,8 @@ bool PairRecovery::estimate(const FeatureFrame& f1, const FeatureFrame& f2,
       ++n_in;
     }
     if (n_in < kMinInliers) return false;
-    Eigen::LDLT<Mat6> ldlt(A);
-    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
-    const Vec6 dx = ldlt.solve(b);
-    if (!dx.allFinite()) return false;
+    Vec6 dx;
+    if (!solveNormalEquations(A, b, dx)) return false;
     x += dx;
     if (gate <= config_.inlier_threshold && dx.segment<2>(0).norm() + dx.segment<2>(3).norm() < 1e-3 &&
         std::abs(dx(2)) + std::abs(dx(5)) < 1e-5)

@@ -9,6 +9,7 @@
 
 #include "spinradar/estimation/doppler.hpp"
 #include "spinradar/core/lie.hpp"
+#include "spinradar/core/normal_equations.hpp"
 
 namespace spinradar {
 
@@ -86,10 +87,8 @@ bool RefinedEstimator::optimise(Eigen::Vector3d& varpi, Eigen::Matrix3d& cov,
       wr2 += w * r2;
       wsum += w;
     }
-    Eigen::LDLT<Eigen::Matrix3d> ldlt(A);
-    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
-    const Eigen::Vector3d d = ldlt.solve(b);
-    if (!d.allFinite()) return false;
+    Eigen::Vector3d d;
+    if (!solveNormalEquations(A, b, d)) return false;
     varpi += d;
     if (it >= 2 && d.head<2>().norm() < 1e-6 && std::abs(d(2)) < 1e-8) break;
   }

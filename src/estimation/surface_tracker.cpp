@@ -7,6 +7,7 @@
 #include <Eigen/LU>
 
 #include "spinradar/core/lie.hpp"
+#include "spinradar/core/normal_equations.hpp"
 #include "spinradar/estimation/doppler.hpp"
 #include "spinradar/estimation/undistort.hpp"
 
@@ -98,10 +99,8 @@ bool SurfaceTracker::solve(const Eigen::Matrix3d& T_pred, const Eigen::Matrix3d&
     }
     if (cnt < kMinAssociations) return false;
     A += A_reg;
-    Eigen::LDLT<Eigen::Matrix3d> ldlt(A);
-    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
-    const Eigen::Vector3d dx = ldlt.solve(b);
-    if (!dx.allFinite()) return false;
+    Eigen::Vector3d dx;
+    if (!solveNormalEquations(A, b, dx)) return false;
     T = T * se2::exp(dx);
     if (dx.head<2>().norm() < 1e-5 && std::abs(dx(2)) < 1e-7) break;
   }
