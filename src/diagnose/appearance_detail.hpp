@@ -73,6 +73,23 @@ AppearanceFinding fitCodeSet(const std::vector<PolarScan>& real, const Appearanc
                              const sim::PhysicsConfig& phys, const AppearanceOptions& opt,
                              std::vector<std::string>& notes);
 
+/// Mean -6 dB range width (bins) of strong isolated returns at 10-100 m on even and odd rows,
+/// their ratio odd / even and its standard error (appearance_chirp.cpp).
+struct ParityWidths {
+  double even = NAN, odd = NAN, ratio = NAN, se = 0, se_even = 0, se_odd = 0;
+  int n_even = 0, n_odd = 0;
+};
+ParityWidths parityRangeWidths(const std::vector<PolarScan>& scans, double counts_per_db,
+                               double sigma_bins);
+/// Alternating chirps of unequal range resolution: fits range_psf_odd_ratio to the recording's
+/// odd / even width ratio on re-simulations; when it is named, range_psf_sigma_bins (the even
+/// rows') is fitted with it from the even rows' width. Findings go to `findings`; true when
+/// both were set in `cur` (the catalogue then leaves the range point spread alone).
+bool fitAlternatingChirps(const std::vector<PolarScan>& real, sim::SensorConfig& cur,
+                          const sim::PhysicsConfig& phys, const AppearanceOptions& opt,
+                          std::vector<AppearanceFinding>& findings,
+                          std::vector<std::string>& notes);
+
 /// With the recording's own scene: the findings of notIdentifiableWithOwnScene parameters are
 /// never named (verdict "not identifiable"), and a note says why (appearance_scene.cpp).
 void markOwnSceneFindings(std::vector<AppearanceFinding>& findings,

@@ -1,7 +1,7 @@
 // Appearance stage: name and fit (appearance.hpp). Saturation and multipath ghosts are tested
-// directly (they are thresholds and switches, not smooth knobs); the smooth parameters are fitted
-// jointly by indirect inference: figures(real) = figures(sim(theta)), Gauss-Newton with the
-// figure Jacobian from re-simulations with each parameter nudged (common random numbers).
+// directly (thresholds and switches, not smooth knobs); the smooth parameters are fitted jointly
+// by indirect inference: figures(real) = figures(sim(theta)), Gauss-Newton, figure Jacobian from
+// re-simulations with each parameter nudged (common random numbers).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -72,17 +72,17 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
                           "): the receiver does not clip within the returns seen; saturation is "
                           "only bounded from below.");
   }
-
   rep.findings.push_back(detail::fitCodeSet(real, rep.real, rep.before, cur, phys, opt, rep.notes));
-  // --- Smooth parameters: block-wise Gauss-Newton on the figures. Each block of parameters is
-  // fitted to the figures it moves most (block-diagonal Jacobian from re-simulations with each
-  // parameter nudged, common random numbers); the blocks are iterated jointly so that their
-  // cross-talk (a wider range spread also changes the CA-CFAR texture) is taken up.
+  const bool chirps = detail::fitAlternatingChirps(real, cur, phys, opt, rep.findings, rep.notes);
+  // --- Smooth parameters: block-wise Gauss-Newton. Each block is fitted to the figures it moves
+  // most (block-diagonal Jacobian from re-simulations, each parameter nudged, common random
+  // numbers); blocks iterate jointly to take up cross-talk (range spread moves CA-CFAR too).
   const auto& params = appearanceParams();
   std::vector<int> active;
   for (int i = 0; i < int(params.size()); ++i) {
     if ((!opt.fit_clutter && params[i].block == 4) ||
-        (!opt.fit_near_stc && params[i].kind == Kind::Range))
+        (!opt.fit_near_stc && params[i].kind == Kind::Range) ||
+        (chirps && params[i].field == &SensorConfig::range_psf_sigma_bins))  // fitted with them
       continue;
     if (opt.hold_gain_chain && notIdentifiableWithOwnScene(params[i].key)) continue;  // combined
     active.push_back(i);

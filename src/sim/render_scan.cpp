@@ -291,8 +291,10 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
   std::fill(w.row.begin(), w.row.end(), 0.f);
   const uint8_t* count_table = model.countTable();
   const int16_t* noise_q = model.noiseQData();
-  const int16_t* speckle_q = model.speckleQData();
   for (int a = 0; a < N; ++a) {
+    // Alternating chirps of unequal resolution: odd rows take their own point spread and speckle.
+    const detail::RenderModel& rm = (a & 1) && model_odd ? *model_odd : model;
+    const int16_t* speckle_q = rm.speckleQData();
     float* row = w.row.data();
     int lo = M, hi = -1;  // touched bins
     const double px = w.px[a], py = w.py[a], c = w.cyaw[a], s = w.syaw[a];
@@ -356,8 +358,8 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
       float pf = float(p);
       float thr = model.thresholdLin(bc);
       if (pf < thr) continue;
-      int h = model.psfHalfFor(pf / thr);
-      const float* taps = model.psf(phase) + H;
+      int h = rm.psfHalfFor(pf / thr);
+      const float* taps = rm.psf(phase) + H;
       int k0 = std::max(-h, -b0), k1 = std::min(h, M - 1 - b0);
       if (k0 > k1) continue;
       for (int kk = k0; kk <= k1; ++kk) row[b0 + kk] += pf * taps[kk];
@@ -384,7 +386,7 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
       float sig = row[b];
       if (sig == 0.f) continue;
       uint32_t idx = start + uint32_t(b);
-      o[b] = model.countOfLin(gain * model.noiseLin(b) * model.speckleLin(idx) + sig);
+      o[b] = model.countOfLin(gain * model.noiseLin(b) * rm.speckleLin(idx) + sig);
       row[b] = 0.f;  // leave the row clean for the next azimuth
     }
   }

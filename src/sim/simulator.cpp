@@ -74,6 +74,11 @@ Simulator::Impl::Impl(World w, Trajectory t, SensorConfig s, PhysicsConfig p, ui
       fx(detail::ExtraEffects::from(physics)),
       model(sensor) {
   if (traj.samples().size() < 2) throw std::invalid_argument("simulator: empty trajectory");
+  if (sensor.range_psf_odd_ratio != 1.0) {
+    SensorConfig odd = sensor;
+    odd.range_psf_sigma_bins = std::min(sensor.range_psf_sigma_bins * sensor.range_psf_odd_ratio, 20.0);
+    model_odd = std::make_unique<detail::RenderModel>(odd);
+  }
   t_ref = traj.startTime();
   buildScatterers();
   for (auto* v : {&statics, &movers})

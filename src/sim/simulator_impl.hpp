@@ -2,6 +2,7 @@
 // Internals of Simulator: the scene turned into scatterers, a spatial grid over them, the
 // parsed effect settings and the per-scan rendering.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "render_model.hpp"
@@ -64,6 +65,9 @@ struct Simulator::Impl {
   uint64_t seed;
   detail::ExtraEffects fx;
   detail::RenderModel model;
+  /// Odd azimuths' range response when range_psf_odd_ratio != 1 (alternating chirps of unequal
+  /// resolution): its point spread and speckle; everything else comes from `model`.
+  std::unique_ptr<detail::RenderModel> model_odd;
 
   std::vector<detail::Scatterer> statics;
   std::vector<detail::Scatterer> movers;
