@@ -111,8 +111,8 @@ bool fitAlternatingChirps(const std::vector<PolarScan>& real, SensorConfig& cur,
   if (sig)
     note << "; fitted range_psf_odd_ratio " << value << " +- " << sd << ", range_psf_sigma_bins "
          << sigma << " +- " << sd_sigma << " (model widths " << fit.odd << " / " << fit.even
-         << "; the catalogue's range point spread, whose isolated-peak window cuts the wider "
-            "rows' responses, is not fitted then)";
+         << "; this replaces the catalogue's range point spread, fitted to the pooled rows, whose "
+            "isolated-peak window cuts the wider rows' responses)";
   notes.push_back(note.str() + ".");
   AppearanceFinding f = makeFinding("odd-row range spread (alternating chirps)",
                                     "range_psf_odd_ratio", "", base, value, sd,
@@ -130,8 +130,21 @@ bool fitAlternatingChirps(const std::vector<PolarScan>& real, SensorConfig& cur,
                                     "relative",
                                     std::abs(sigma / base_sigma - 1) >= opt.width_rel_min, opt.z_min);
   g.gap_before = r.even - m.even, g.gap_after = r.even - fit.even;
-  findings.push_back(g);
-  cur.range_psf_sigma_bins = sigma;  // fitted, named or not: the catalogue holds it
+  // It replaces the catalogue's range point spread (fitted to the pooled rows before it): the
+  // base and the figure stay the catalogue's base model's.
+  auto old = std::find_if(findings.begin(), findings.end(), [](const AppearanceFinding& x) {
+    return x.parameter == "range_psf_sigma_bins";
+  });
+  if (old != findings.end()) {
+    g = makeFinding(g.effect, g.parameter, g.unit, old->base, sigma, sd_sigma,
+                    std::abs(sigma / old->base - 1), "relative",
+                    std::abs(sigma / old->base - 1) >= opt.width_rel_min, opt.z_min);
+    g.gap_before = old->gap_before, g.gap_after = r.even - fit.even;
+    *old = g;
+  } else {
+    findings.push_back(g);
+  }
+  cur.range_psf_sigma_bins = sigma;  // fitted, named or not
   return true;
 }
 

@@ -83,8 +83,9 @@ ParityWidths parityRangeWidths(const std::vector<PolarScan>& scans, double count
                                double sigma_bins);
 /// Alternating chirps of unequal range resolution: fits range_psf_odd_ratio to the recording's
 /// odd / even width ratio on re-simulations; when it is named, range_psf_sigma_bins (the even
-/// rows') is fitted with it from the even rows' width. Findings go to `findings`; true when
-/// both were set in `cur` (the catalogue then leaves the range point spread alone).
+/// rows') is fitted with it from the even rows' width, replacing the catalogue's finding. Findings
+/// go to `findings`; true when both were set in `cur`. Runs after the catalogue, before the
+/// range curves.
 bool fitAlternatingChirps(const std::vector<PolarScan>& real, sim::SensorConfig& cur,
                           const sim::PhysicsConfig& phys, const AppearanceOptions& opt,
                           std::vector<AppearanceFinding>& findings,

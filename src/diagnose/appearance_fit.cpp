@@ -73,7 +73,6 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
                           "only bounded from below.");
   }
   rep.findings.push_back(detail::fitCodeSet(real, rep.real, rep.before, cur, phys, opt, rep.notes));
-  const bool chirps = detail::fitAlternatingChirps(real, cur, phys, opt, rep.findings, rep.notes);
   // --- Smooth parameters: block-wise Gauss-Newton. Each block is fitted to the figures it moves
   // most (block-diagonal Jacobian from re-simulations, each parameter nudged, common random
   // numbers); blocks iterate jointly to take up cross-talk (range spread moves CA-CFAR too).
@@ -81,8 +80,7 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
   std::vector<int> active;
   for (int i = 0; i < int(params.size()); ++i) {
     if ((!opt.fit_clutter && params[i].block == 4) ||
-        (!opt.fit_near_stc && params[i].kind == Kind::Range) ||
-        (chirps && params[i].field == &SensorConfig::range_psf_sigma_bins))  // fitted with them
+        (!opt.fit_near_stc && params[i].kind == Kind::Range))
       continue;
     if (opt.hold_gain_chain && notIdentifiableWithOwnScene(params[i].key)) continue;  // combined
     active.push_back(i);
@@ -367,6 +365,8 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
   // --- Noise texture correlation (appearance_texture.cpp), before the range curves.
   rep.findings.push_back(detail::fitTextureLength(real, cur, phys, opt, rep.notes));
   if (rep.findings.back().named) rep.after = figuresOf(cur, phys);
+  // Alternating chirps (appearance_chirp.cpp): odd rows' and even rows' range spread.
+  if (detail::fitAlternatingChirps(real, cur, phys, opt, rep.findings, rep.notes)) rep.after = figuresOf(cur, phys);
 
   // --- Per-band calibration: range curves on the per-band realism figures.
   if (opt.realism && opt.curve_iterations > 0) {
