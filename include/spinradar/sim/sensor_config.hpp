@@ -37,7 +37,7 @@
   X(double, compression_knee, 255.0, 1.0, 255.0, "count", "Output count above which the receiver compresses") \
   X(double, compression_ratio, 1.0, 0.05, 1.0, "", "Output counts per dB above the compression knee (1 = none)") \
   X(double, range_psf_sigma_bins, 2.7, 0.3, 20.0, "bins", "Std of the Gaussian-like range mainlobe in power (real CTS350-X/CIR204: ~2.7)") \
-  X(double, range_psf_odd_ratio, 1.0, 0.5, 3.0, "", "Range mainlobe std (and noise correlation) on odd azimuths over range_psf_sigma_bins, which holds for even ones: alternating chirps of unequal range resolution (Boreas-RT RAS6: the up chirp on odd rows, about 1.4); 1 = one chirp") \
+  X(double, range_psf_odd_ratio, 1.0, 0.5, 3.0, "", "Range mainlobe std (and noise correlation) on odd azimuths over range_psf_sigma_bins, which holds for even ones: alternating chirps of unequal range resolution (Boreas-RT RAS6: the up chirp on odd rows, fitted 1.32); 1 = one chirp") \
   X(double, range_sidelobe_db, -60.0, -120.0, -10.0, "dB", "FFT-window range sidelobe level (decaying as offset^-3)") \
   X(int, range_psf_half_width, 24, 2, 64, "bins", "Half width of the rendered range point spread") \
   X(double, azimuth_sidelobe_db, -50.0, -80.0, -10.0, "dB", "Two-way azimuth sidelobe plateau relative to the peak") \
