@@ -36,7 +36,9 @@
   X(double, range_sigma, 0.0438, 0.001, 1.0, "m", "Range noise std for Cartesian covariance weighting") \
   X(double, azimuth_sigma, 0.0045, 0.0001, 0.1, "rad", "Azimuth noise std for Cartesian covariance weighting") \
   X(bool, robust_loss, true, 0, 1, "", "Cauchy loss, scaled by the median residual, in the refit of refined (the pair estimate of keyframe and surface); false: every gated match weighted 1. mc and mc_doppler stay the paper's least squares") \
-  X(std::string, azimuth_times, "stamps", 0, 0, "", "Keypoint times: stamps (each row's recorded stamp) or uniform (a line fitted to the scan's row stamps: for stamps that are packet arrival times, as in Oxford and MulRan)")
+  X(std::string, azimuth_times, "stamps", 0, 0, "", "Keypoint times: stamps (each row's recorded stamp) or uniform (a line fitted to the scan's row stamps: for stamps that are packet arrival times, as in Oxford and MulRan)") \
+  X(int, submap_keyframes, 1, 1, 8, "", "keyframe: a new keyframe's map points are averaged with their nearest points (within 0.5 m) in the last submap_keyframes - 1 keyframes, which averages the scatter (glint) of the map's returns (1: its own points, as before)") \
+  X(double, floor_gate, 0.0, 0.0, 20.0, "x floor", "keyframe: the registration's inlier gate is at least this multiple of its measured tangential noise floor (0: inlier_threshold only)")
 // clang-format on
 
 namespace spinradar {

@@ -70,7 +70,10 @@ class KeyframeTracker {
  public:
   explicit KeyframeTracker(const EstimatorConfig& config = EstimatorConfig{});
   void setConfig(const EstimatorConfig& config) { config_ = config; }
-  void reset() { has_key_ = has_last_stamp_ = false; }
+  void reset() {
+    has_key_ = has_last_stamp_ = false;
+    submap_count_ = submap_next_ = 0;
+  }
 
   /// cur: the newest scan (raw keypoints and descriptors). pair: the frame-to-frame estimate
   /// from the previous scan to cur (ok); T_12 is updated in place to the step actually taken
@@ -174,6 +177,10 @@ class KeyframeTracker {
   static constexpr int kFloorMinMatches = 10;
   static constexpr double kFloorTolerance = 0.01;
   static constexpr int kFloorIterations = 4;
+  /// m: with EstimatorConfig::submap_keyframes > 1, a new keyframe point is averaged with the
+  /// nearest point within this gate of each earlier keyframe of the submap (keyframe_map.cpp):
+  /// 2.5 sigma of the difference of two returns under the simulator's 0.14 m glint.
+  static constexpr double kSubmapGate = 0.5;
 
  private:
   ScanPeriod scan_period_;  ///< the rotation period, for the mid-scan reference (gaps)
@@ -247,6 +254,21 @@ class KeyframeTracker {
                             const Eigen::Vector3d& xi, double c, double gate);
   void addMatch(size_t key_index, const Keypoint& k, double tau);
   double row_step_ = 0.0;  ///< rowQuantization() of the scan being tracked
+  /// The submap (EstimatorConfig::submap_keyframes, issue 19): the raw points of the last
+  /// keyframes (a ring), each at its mid-scan reference, with its mid-scan world pose.
+  struct SubmapFrame {
+    std::vector<Eigen::Vector2d> pts;
+    std::vector<std::pair<double, int>> by_x;  ///< (x, index) of pts, sorted by x
+    Eigen::Matrix3d M_w = Eigen::Matrix3d::Identity();
+  };
+  std::vector<SubmapFrame> submap_;
+  size_t submap_count_ = 0, submap_next_ = 0;
+  std::vector<Eigen::Vector2d> avg_sum_;
+  std::vector<int> avg_n_;
+  /// Averages each new keyframe point (key_pts_, raw, mid-scan world pose M_w) with its
+  /// nearest point within kSubmapGate in each earlier keyframe of the ring, then puts the raw
+  /// points into the ring. Nothing with submap_keyframes 1.
+  void averageWithSubmap(const Eigen::Matrix3d& M_w);
 };
 
 }  // namespace spinradar
