@@ -31,7 +31,9 @@ constexpr int kTypes = 3;  // receiver gain curve, return gain curve, clutter de
 // row against 2.4 in the other rows, and every band's Cen2018 count came out 15-20 % high. The
 // floor is not a realism gap figure (kGapFigures): it only pins the noise side. Opt-in
 // (AppearanceOptions::fit_band_floor): with it the reference scene cannot give Oxford's counts.
-constexpr int kPerBand = 5;
+// The share of zero counts (opt-in, AppearanceOptions::fit_band_zeros), also on the noise side:
+// the floor is 0 once half the counts are zero and no longer moves with the noise level.
+constexpr int kPerBand = 6;
 constexpr int kGapFigures = 4;  // the first four are the realism figures the gaps are taken on
 // noise texture (dB), median clutter RCS (dBsm), 10 log2 of the counts per dB (rescaled codes
 // only), 10 log2 of the range spread (AppearanceOptions::fit_spread_bands: the CA-CFAR cells
@@ -87,7 +89,8 @@ void setParam(SensorConfig& s, int type, int j, double p) {
   }
 }
 
-const char* const kFigureNames[kPerBand] = {"mean", "q90", "cacfar", "cen2018", "floor"};
+const char* const kFigureNames[kPerBand] = {"mean", "q90", "cacfar", "cen2018", "floor",
+                                               "zeros"};
 
 // Scene-dependent figures weigh nothing: their rows of the residual and the Jacobian are zero.
 Eigen::VectorXd logFigures(const sim::RealismStats& st, const AppearanceOptions& opt) {
@@ -98,6 +101,9 @@ Eigen::VectorXd logFigures(const sim::RealismStats& st, const AppearanceOptions&
     v[kPerBand * k + 2] = std::log(1 + st.band_cacfar[k]);
     v[kPerBand * k + 3] = opt.fit_cen2018 ? std::log(1 + std::max(st.band_cen[k], 0.0)) : 0.0;
     v[kPerBand * k + 4] = opt.fit_band_floor ? std::log(1 + st.band_floor[k]) : 0.0;
+    // Log of the share (a 10 % share 5 points off weighs as a 40 % one 20 points off), kept
+    // finite at no zeros.
+    v[kPerBand * k + 5] = opt.fit_band_zeros ? std::log(0.02 + st.band_zero[k]) : 0.0;
     for (int i = 0; i < kPerBand; ++i)
       if (isSceneDependent(k, kFigureNames[i])) v[kPerBand * k + i] = 0;
   }

@@ -126,6 +126,7 @@ nlohmann::json AppearanceReport::toJson() const {
     b["cen2018"] = std::vector<double>(s.band_cen, s.band_cen + 4);
     // Not a gap figure: the noise side, which tells receiver noise from weak clutter.
     b["floor"] = std::vector<double>(s.band_floor, s.band_floor + 4);
+    b["zero"] = std::vector<double>(s.band_zero, s.band_zero + 4);
     return b;
   };
   if (!realism_real.name.empty()) {

@@ -155,6 +155,7 @@ RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::stri
       taken += t;
     }
     if (taken > 0) st.band_floor[k] = lo / taken;
+    if (n > 0) st.band_zero[k] = std::clamp(band_hist[k][0] / n, 0.0, 1.0);
     st.band_cacfar[k] = cacfar[k] / ns;
     st.cacfar += cacfar[k] / ns;
     if (o.detect) st.band_cen[k] = cen_band[k] / ns;

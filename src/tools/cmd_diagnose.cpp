@@ -37,6 +37,7 @@ struct DiagnoseArgs {
   int curve_iterations = 16;
   bool no_holdout = false;
   bool fit_floor = false;
+  bool fit_zeros = false;
   bool no_cen2018_fit = false;
   std::string appearance_scene = "city";
   std::string gain_chain;  // scene "combined": held gain chain from this sensor (file or name)
@@ -62,6 +63,7 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   opt.curve_iterations = a.curve_iterations;
   opt.holdout = !a.no_holdout;
   opt.fit_band_floor = a.fit_floor;
+  opt.fit_band_zeros = a.fit_zeros;
   opt.fit_cen2018 = !a.no_cen2018_fit;
   opt.scene = a.appearance_scene;
   opt.scene_margin_db = a.scene_margin_db;
@@ -306,6 +308,10 @@ SPINRADAR_COMMAND(
       app.add_flag("--appearance-fit-floor", a->fit_floor,
                    "Also fit each band's noise floor (lower half of the counts) in the per-band "
                    "calibration: tells receiver noise from weak clutter (docs/diagnose.md)");
+      app.add_flag("--appearance-fit-zeros", a->fit_zeros,
+                   "Also fit each band's share of zero counts in the per-band calibration: the "
+                   "noise level against the first quantiser step, also where over half the "
+                   "counts are zero (MulRan; docs/diagnose_chirps.md)");
       app.add_flag("--appearance-no-cen2018-fit", a->no_cen2018_fit,
                    "Leave the Cen2018 keypoints out of the per-band calibration (still reported): "
                    "with --appearance-fit-floor on Oxford they measure the scene (docs/diagnose_cen2018.md)");

@@ -172,6 +172,32 @@ TEST(AppearanceBands, ConcealedFarNoiseFloorFitted) {
   }
 }
 
+// The share of zero counts (fit_band_zeros) pins the noise level where the floor figure cannot:
+// a recording whose far noise is 6 dB lower (receiver curve -6 dB at 71 m, returns kept) has
+// over half its 50-100 m counts at code 0, so its floor (lower half of the counts) is 0 as in any
+// darker model. The zero share gives the node back within 1 dB; the null (base model, another
+// seed) leaves it within 1 dB of zero.
+TEST(AppearanceBands, ConcealedDarkFarNoiseFittedByZeroShare) {
+  AppearanceOptions opt = quick();
+  opt.fit_band_zeros = true;
+  opt.fit_cen2018 = false;  // the noise side only: Cen2018 counts move with the dark rows too
+  for (const double hidden : {-6.0, 0.0}) {
+    sim::SensorConfig truth = baseSensor();
+    truth.stc_curve_db_71m = hidden;
+    truth.return_gain_db_71m = -hidden;
+    const auto real = sim::computeRealism(renderReference(truth, {}, quick(), 4244), "recording");
+    const sim::SensorConfig fitted = fitRangeCurves(real, baseSensor(), {}, opt);
+    const auto after = realismOf(fitted, {}, opt, opt.seed + 1, "after");
+    if (std::getenv("SPINRADAR_TEST_VERBOSE"))
+      std::cerr << "hidden " << hidden << ": noise node 71 m " << fitted.stc_curve_db_71m
+                << ", zeros 50-100 m real " << real.band_zero[3] << " fitted " << after.band_zero[3]
+                << ", floor real " << real.band_floor[3] << "\n";
+    if (hidden < 0) EXPECT_GT(real.band_zero[3], 0.5);  // the floor figure is blind here
+    EXPECT_NEAR(fitted.stc_curve_db_71m, hidden, 1.0) << hidden;
+    EXPECT_NEAR(after.band_zero[3], real.band_zero[3], 0.1 * real.band_zero[3]) << hidden;
+  }
+}
+
 // Left out of the fit (fit_cen2018 off), the Cen2018 counts cannot move it: a recording with
 // any Cen2018 figures gives the same curves.
 TEST(AppearanceBands, Cen2018LeftOutCannotDriveTheFit) {

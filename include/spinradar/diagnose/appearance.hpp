@@ -120,6 +120,10 @@ struct AppearanceOptions {
   /// default fit 0.0) but the reference city scene then cannot give Oxford's Cen2018 counts
   /// (docs/diagnose.md, "Oxford's Cen2018 counts").
   bool fit_band_floor = false;
+  /// Also fit each band's share of zero counts (sim::RealismStats::band_zero): pins the noise
+  /// level against the quantiser's first step, also where more than half the counts are zero
+  /// (there the floor figure is 0 whatever the noise). Not a realism gap figure.
+  bool fit_band_zeros = false;
   /// Let the Cen2018 keypoints per band drive the range-curve fit (they are still measured and
   /// in every gap figure either way). Off = they weigh nothing: with the floors fitted, the
   /// reference city scene cannot give Oxford's counts (a third at 10-25 m; scene content,

@@ -38,6 +38,11 @@ struct RealismStats {
   /// Per range band: mean of the lower half of the counts (the receiver noise side; the
   /// appearance stage's range-curve fit needs it to tell noise from clutter, not a realism gap).
   double band_floor[4] = {0, 0, 0, 0};
+  /// Per range band: share of the counts at code 0 (0-1; native codes: amplitude under 2, the
+  /// receiver noise against the first quantiser step). Unlike band_floor it keeps moving with
+  /// the noise level when more than half the counts are zero (MulRan's fit: 59 % zeros,
+  /// recording 30-40 %; docs/diagnose_chirps.md).
+  double band_zero[4] = {0, 0, 0, 0};
   double cacfar = 0;              ///< plain CA-CFAR cells per scan, all bands
 };
 
