@@ -96,9 +96,11 @@ bool fitAlternatingChirps(const std::vector<PolarScan>& real, sim::SensorConfig&
 void markOwnSceneFindings(std::vector<AppearanceFinding>& findings,
                           std::vector<std::string>& notes);
 
-/// Glint (physics "glint", glint_fit.hpp) of the consecutive scans `real` against cur/phys: its
-/// finding and a note with the spread before/after go to `rep`; sets it in `phys` when named.
-void appendGlint(const std::vector<PolarScan>& real, const sim::SensorConfig& cur,
+/// Glint terms (physics glint_across, glint_along, azimuth_jitter; glint_terms.hpp) of the
+/// consecutive scans `real` against cur/phys: their findings and a note with the spread
+/// before/after go to `rep`; the named ones are set in the sensor's physics (`cur.physics`, what a
+/// calibrated sensor file carries), the others removed from it.
+void appendGlint(const std::vector<PolarScan>& real, sim::SensorConfig& cur,
                  sim::PhysicsConfig& phys, const AppearanceOptions& opt, AppearanceReport& rep);
 
 }  // namespace spinradar::diagnose::detail

@@ -381,7 +381,10 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
       rep.after = figuresOf(cur, phys);
     }
   }
-  if (opt.fit_glint) detail::appendGlint(real, cur, phys, opt, rep);  // appearance_glint.cpp
+  // Glint terms (appearance_glint.cpp) on every consecutive pair of the recording, held-out part
+  // too: the spread is a figure of pairs, and halving three scans leaves one (one-scan samples,
+  // split by azimuth, have none either way). Its check is `spinradar spread` on the real samples.
+  if (opt.fit_glint) detail::appendGlint(recording, cur, phys, opt, rep);
   if (opt.scene == "recording" && !opt.hold_gain_chain) detail::markOwnSceneFindings(rep.findings, rep.notes);
   std::stable_sort(rep.findings.begin(), rep.findings.end(),
                    [](const AppearanceFinding& a, const AppearanceFinding& b) {

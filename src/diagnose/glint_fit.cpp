@@ -53,28 +53,30 @@ MatchedSpread referenceSpread(const sim::SensorConfig& sensor, const sim::Physic
   MatchedSpread out = seg.front();
   auto merge = [&](auto get) {
     SpreadBand m;
-    double w = 0, se2 = 0;
-    std::vector<double> t;
+    double w = 0, se2t = 0, se2r = 0;
+    std::vector<double> t, r;
     for (auto& x : seg) {
       const SpreadBand& b = get(x);
       if (!std::isfinite(b.tangential) || b.matches < 2) continue;
       m.tangential += b.matches * b.tangential, m.radial += b.matches * b.radial;
-      se2 += b.tangential_se * b.tangential_se;
+      m.range += b.matches * b.range;
+      se2t += b.tangential_se * b.tangential_se, se2r += b.radial_se * b.radial_se;
       w += b.matches, m.matches += b.matches;
-      t.push_back(b.tangential);
+      t.push_back(b.tangential), r.push_back(b.radial);
     }
     if (w <= 0) return SpreadBand{NAN, NAN, NAN, NAN, 0};
-    m.tangential /= w, m.radial /= w;
-    double sd = 0;
-    if (t.size() >= 2) {
-      double mu = 0;
-      for (double x : t) mu += x;
-      mu /= t.size();
-      for (double x : t) sd += (x - mu) * (x - mu);
-      sd = std::sqrt(sd / (t.size() - 1));
-    }
-    m.tangential_se = std::max(std::sqrt(se2) / t.size(), sd / std::sqrt(double(t.size())));
-    m.radial_se = m.tangential_se;
+    m.tangential /= w, m.radial /= w, m.range /= w;
+    auto sdOf = [](const std::vector<double>& v) {
+      if (v.size() < 2) return 0.0;
+      double mu = 0, sd = 0;
+      for (double x : v) mu += x;
+      mu /= v.size();
+      for (double x : v) sd += (x - mu) * (x - mu);
+      return std::sqrt(sd / (v.size() - 1));
+    };
+    const double n = double(t.size());
+    m.tangential_se = std::max(std::sqrt(se2t) / n, sdOf(t) / std::sqrt(n));
+    m.radial_se = std::max(std::sqrt(se2r) / n, sdOf(r) / std::sqrt(n));
     return m;
   };
   for (int b = 0; b < 4; ++b) out.band[b] = merge([b](MatchedSpread& x) -> SpreadBand& { return x.band[b]; });

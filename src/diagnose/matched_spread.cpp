@@ -241,6 +241,8 @@ MatchedSpread measureMatchedSpread(const std::vector<PolarScan>& scans,
   for (size_t i = 0; i < scans.size(); ++i) total += (ret[i] = spreadReturns(scans[i], opt)).size();
   out.returns = scans.empty() ? 0 : int(total / long(scans.size()));
   std::array<std::vector<double>, 4> et, er;
+  std::array<double, 4> rsum{};
+  double rall = 0;
   std::vector<double> all_t, all_r;
   Eigen::Matrix3d prev = Eigen::Matrix3d::Identity();
   for (size_t i = 0; i + 1 < scans.size(); ++i) {
@@ -262,6 +264,7 @@ MatchedSpread measureMatchedSpread(const std::vector<PolarScan>& scans,
       const Eigen::Vector2d u = a[j] / r, e = tb[k] - a[j];
       const double rad = e.dot(u), tan = e.x() * -u.y() + e.y() * u.x();
       et[band].push_back(tan), er[band].push_back(rad);
+      rsum[band] += r, rall += r;
       all_t.push_back(tan), all_r.push_back(rad), pair_t.push_back(tan);
     }
     out.pair_tangential.push_back(robustStd(pair_t));
@@ -272,8 +275,12 @@ MatchedSpread measureMatchedSpread(const std::vector<PolarScan>& scans,
     s.tangential = robustStd(t), s.radial = robustStd(r);
     s.tangential_se = madSe(s.tangential, t.size()), s.radial_se = madSe(s.radial, r.size());
   };
-  for (int k = 0; k < 4; ++k) fill(out.band[k], et[k], er[k]);
+  for (int k = 0; k < 4; ++k) {
+    fill(out.band[k], et[k], er[k]);
+    out.band[k].range = et[k].empty() ? 0 : rsum[k] / double(et[k].size());
+  }
   fill(out.all, all_t, all_r);
+  out.all.range = all_t.empty() ? 0 : rall / double(all_t.size());
   // Matches of one scene are not independent: the pairs' own scatter when there are enough.
   std::vector<double> pt;
   for (double x : out.pair_tangential)

@@ -1,6 +1,7 @@
 // Physics configuration: effect name -> value, absent meaning off.
 #include "spinradar/sim/physics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
@@ -60,7 +61,9 @@ void checkExtra(const std::string& key, const nlohmann::json& v) {
     num(v, k, 0.0, 1000.0);
   } else if (key == "encoder_wobble") {
     num(v, k, -0.1, 0.1);
-  } else if (key == "glint") {
+  } else if (key == "glint" || key == "glint_across" || key == "glint_along") {
+    num(v, k, 0.0, 5.0);
+  } else if (key == "azimuth_jitter") {
     num(v, k, 0.0, 5.0);
   } else if (key == "chirp_alternate") {
     flag(v, k);
@@ -72,7 +75,8 @@ void checkExtra(const std::string& key, const nlohmann::json& v) {
                         "unknown effect (expected motion_distortion, doppler, timestamp_offset, "
                         "azimuth_offset, range_offset, moving_objects, stamp_bursts, "
                         "rotation_jitter, multipath, attenuation, encoder_wobble, "
-                        "chirp_alternate, scan_pose_time, glint)");
+                        "chirp_alternate, scan_pose_time, glint, glint_across, glint_along, "
+                        "azimuth_jitter)");
   }
 }
 
@@ -135,6 +139,35 @@ std::vector<std::string> PhysicsConfig::activeEffects() const {
   if (moving_objects) out.push_back("moving_objects");
   for (auto it = extra.begin(); it != extra.end(); ++it)
     if (isOn(*it)) out.push_back(it.key());
+  return out;
+}
+
+PhysicsConfig PhysicsConfig::withSensorPhysics(const std::map<std::string, double>& sp) const {
+  PhysicsConfig p = *this;
+  for (const auto& [key, value] : sp)
+    if (!p.extra.contains(key)) p.extra[key] = value;
+  return p;
+}
+
+const std::vector<std::string> kSensorPhysicsKeys = {"glint", "glint_across", "glint_along",
+                                                     "azimuth_jitter"};
+
+std::map<std::string, double> sensorPhysicsFromJson(const nlohmann::json& j) {
+  if (!j.is_object()) throw JsonPathError({{"physics", -1}}, "must be a JSON object");
+  std::map<std::string, double> out;
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& key = it.key();
+    if (std::find(kSensorPhysicsKeys.begin(), kSensorPhysicsKeys.end(), key) == kSensorPhysicsKeys.end())
+      throw JsonPathError({{"physics", -1}, {key, -1}},
+                          "not a sensor physics key (expected glint, glint_across, glint_along, "
+                          "azimuth_jitter)");
+    try {
+      checkExtra(key, *it);
+    } catch (const JsonPathError& e) {
+      throw JsonPathError({{"physics", -1}, {key, -1}}, e.reason);
+    }
+    out[key] = it->get<double>();
+  }
   return out;
 }
 

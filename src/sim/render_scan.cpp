@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "glint.hpp"
 #include "simulator_impl.hpp"
 
 namespace spinradar::sim {
@@ -116,6 +117,7 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
     out.encoder[a] = uint16_t(enc);
     out.azimuth[a] = az_rep;
     w.psi[a] = wrap2Pi(az_rep - physics.azimuth_offset - fx.encoder_wobble * std::sin(az_rep));
+    if (fx.azimuth_jitter > 0) w.psi[a] = wrap2Pi(w.psi[a] + detail::azimuthJitter(fx, seed, scan_key, a));
     double stamp = t0 + a * dt;
     if (fx.bursts) {
       int first = a / fx.burst_size * fx.burst_size;
@@ -133,17 +135,9 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
   for (int a = 0; a < N; a += 8) travel = std::max(travel, std::hypot(w.px[a] - mx, w.py[a] - my));
   travel = std::max({travel, std::hypot(w.px[0] - mx, w.py[0] - my),
                      std::hypot(w.px[N - 1] - mx, w.py[N - 1] - my)});
-  // Glint: the scattering centre of every scatterer moves by an isotropic 2-D normal draw per
-  // scan (the same in bucketing and rendering): where on an extended object (facade relief,
-  // bush, car) the return comes from changes with the aspect. Off (0): no draw, output unchanged.
-  const uint64_t glint_key = detail::Rng::splitmix(seed ^ (scan_key * 0xD1B54A32D192ED03ull));
-  auto glint = [&](uint32_t id, double& x, double& y) {
-    if (fx.glint <= 0) return;
-    const double u1 = detail::hashUniform(glint_key, id, 1), u2 = detail::hashUniform(glint_key, id, 2);
-    const double m = fx.glint * std::sqrt(-2.0 * std::log(std::max(u1, 1e-300)));
-    x += m * std::cos(kTwoPi * u2);
-    y += m * std::sin(kTwoPi * u2);
-  };
+  // Glint (glint.hpp): the scattering centres move per scan; off: no draw, output unchanged.
+  const detail::Glint glint_fx(fx, seed, scan_key, mx, my);
+  auto glint = [&](uint32_t id, double& x, double& y) { glint_fx.apply(id, x, y); };
   const double inv_az_step = 1.0 / az_step;
   auto azOf = [&](double psi) {  // azimuth index whose true beam angle is nearest psi
     int a = int(std::floor((psi + physics.azimuth_offset) * inv_az_step + 0.5));
@@ -233,7 +227,7 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
       if (hidden) return;
     }
     // Slack for the bearing change across the pattern when close and moving.
-    double slack = r > 1 ? travel / r * 0.1 : 0.5;
+    double slack = (r > 1 ? travel / r * 0.1 : 0.5) + 4 * fx.azimuth_jitter;
     int K = int(std::ceil((half + slack) / az_step)) + 1;
     K = std::min(K, N / 2);
     for (int k = -K; k <= K; ++k) {

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "file_errors.hpp"
+#include "spinradar/sim/physics.hpp"
 #include "spinradar/core/param_check.hpp"
 
 namespace spinradar::sim {
@@ -73,6 +74,7 @@ bool SensorConfig::hasRangeCurves() const {
 nlohmann::json SensorConfig::toJson() const {
   nlohmann::json j = nlohmann::json::object();
   visit([&](const ParamMeta& m, const auto& v) { j[m.name] = v; });
+  if (!physics.empty()) j["physics"] = physics;
   return j;
 }
 
@@ -80,6 +82,10 @@ SensorConfig SensorConfig::fromJson(const nlohmann::json& j) {
   if (!j.is_object()) throw detail::JsonPathError({}, "sensor configuration must be a JSON object");
   SensorConfig c;
   for (auto it = j.begin(); it != j.end(); ++it) {
+    if (it.key() == "physics") {
+      c.physics = sensorPhysicsFromJson(*it);
+      continue;
+    }
     bool found = false;
     c.visit([&](const ParamMeta& m, auto& v) {
       if (it.key() != m.name) return;

@@ -38,6 +38,9 @@ ExtraEffects ExtraEffects::from(const PhysicsConfig& p) {
   if (on("encoder_wobble")) e.encoder_wobble = x["encoder_wobble"].get<double>();
   if (on("chirp_alternate")) e.chirp_alternate = true;
   if (on("glint")) e.glint = x["glint"].get<double>();
+  if (on("glint_across")) e.glint_across = x["glint_across"].get<double>();
+  if (on("glint_along")) e.glint_along = x["glint_along"].get<double>();
+  if (on("azimuth_jitter")) e.azimuth_jitter = x["azimuth_jitter"].get<double>() * M_PI / 180.0;
   if (on("attenuation")) e.attenuation_db_per_km = x["attenuation"].get<double>();
   if (on("multipath")) {
     e.multipath = true;
@@ -69,7 +72,7 @@ Simulator::Impl::Impl(World w, Trajectory t, SensorConfig s, PhysicsConfig p, ui
     : world(std::move(w)),
       traj(std::move(t)),
       sensor(checked(std::move(s))),
-      physics(std::move(p)),
+      physics(p.withSensorPhysics(sensor.physics)),
       seed(sd),
       fx(detail::ExtraEffects::from(physics)),
       model(sensor) {

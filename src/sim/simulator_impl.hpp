@@ -38,6 +38,9 @@ struct ExtraEffects {
   double multipath_db = -15.0;    ///< ghost power relative to the direct return
   bool pose_at_start = false;     ///< motion_distortion off: pose of scan start, not middle
   double glint = 0.0;             ///< m, per-scan std of the scattering-centre shift
+  double glint_across = 0.0;      ///< m, the same across the line of sight only
+  double glint_along = 0.0;       ///< m, the same along the line of sight only
+  double azimuth_jitter = 0.0;    ///< rad, per-row std of the true beam angle
 
   static ExtraEffects from(const PhysicsConfig& p);
 };

@@ -8,7 +8,7 @@
 #include "cli_checks.hpp"
 #include "command.hpp"
 #include "scene_comparison_options.hpp"
-#include "spinradar/diagnose/glint_fit.hpp"
+#include "spinradar/diagnose/glint_terms.hpp"
 #include "spinradar/diagnose/matched_spread.hpp"
 #include "spinradar/io/scan_folder.hpp"
 #include "spinradar/sim/realism.hpp"
@@ -73,13 +73,13 @@ void runSpread(const SpreadCmdOptions& o) {
              diagnose::measureMatchedSpread(scans, nullptr, o.spread));
   }
   for (const auto& [name, scans] : fits) {
-    // Against the model without glint (the glint of --physics/--glint is the base).
-    diagnose::GlintOptions go;
-    go.spread = o.spread;
-    const auto g = diagnose::fitGlint(scans, sensor, physics, go);
-    std::printf("\n%s: glint %.3f +- %.3f m (z %.1f, %s) against the sensor model%s\n%s", name.c_str(),
-                g.value, g.stddev, g.z, g.verdict.c_str(),
-                o.sensor.empty() ? "" : (" " + o.sensor).c_str(), diagnose::glintTable(g).c_str());
+    // The glint terms against the sensor model without its own (the glint of --physics/--glint
+    // is kept as the base).
+    diagnose::GlintTermsOptions go;
+    go.ref.spread = o.spread;
+    const auto g = diagnose::fitGlintTerms(scans, sensor, physics, go);
+    std::printf("\n%s: glint terms against the sensor model%s\n%s", name.c_str(),
+                o.sensor.empty() ? "" : (" " + o.sensor).c_str(), diagnose::glintTermsTable(g).c_str());
   }
   std::cout << "\nRobust std (1.4826 MAD) of the difference of mutually nearest returns of "
                "consecutive scans after alignment, m: across the beam / along it (matches).\n";
@@ -106,7 +106,8 @@ SPINRADAR_COMMAND("spread", "Spread of returns matched between consecutive scans
                         ->capture_default_str()
                         ->check(CLI::Range(0.1, 5.0));
                     app.add_flag("--fit", o->fit,
-                                 "Fit the glint of the real samples and --recording folders "
-                                 "(reference: the city route with --sensor)");
+                                 "Fit the glint terms (glint_across, glint_along, azimuth_jitter) of "
+                                 "the real samples and --recording folders (reference: the city "
+                                 "route with --sensor)");
                     app.callback([o] { runSpread(*o); });
                   });

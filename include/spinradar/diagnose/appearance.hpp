@@ -135,8 +135,10 @@ struct AppearanceOptions {
   /// RADIATE's held out 23 -> 20 %, but Oxford's combined 14 -> 20 % and MulRan's 20 -> 25 %
   /// (docs/diagnose_scene.md).
   bool fit_spread_bands = false;
-  /// Fit the glint (per-scan shift of the scattering centres, physics "glint") to the spread of
-  /// returns matched between consecutive scans (glint_fit.hpp); needs two distinct scans.
+  /// Fit the glint terms (per-scan shift of the scattering centres across and along the beam,
+  /// per-row azimuth jitter: physics glint_across, glint_along, azimuth_jitter, carried by the
+  /// fitted sensor) to the spread of returns matched between consecutive scans
+  /// (glint_terms.hpp); needs two distinct scans.
   bool fit_glint = true;
   /// Fit on part of the recording and check on the rest (splitHoldout).
   bool holdout = true;

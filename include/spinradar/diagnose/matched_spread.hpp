@@ -29,6 +29,7 @@ struct SpreadBand {
   double tangential = 0, radial = 0;        ///< robust std (1.4826 MAD) of the matched difference, m
   double tangential_se = 0, radial_se = 0;  ///< standard errors, m
   int matches = 0;
+  double range = 0;  ///< mean range of the matched returns, m
 };
 
 struct MatchedSpread {

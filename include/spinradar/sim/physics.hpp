@@ -16,6 +16,14 @@
 //   "glint": m   per-axis std of a per-scan isotropic random shift of every scatterer's
 //       scattering centre (where on an extended object the return comes from changes with the
 //       aspect; real Oxford ~0.1 m, `spinradar spread`); 0 = off, the default
+//   "glint_across": m  per-scan std of the scattering-centre shift across the line of sight
+//       (seen from the scan's middle pose); "glint_along": m  the same along it. The real
+//       spread is anisotropic (RADIATE 0.25 m across, 0.12 along; docs/diagnose_glint.md)
+//   "azimuth_jitter": deg  std of a per-row error of the true beam angle (independent per
+//       azimuth row and scan): the across-beam spread it adds grows with range
+//   Each 0 = off, the default (output byte-identical). These four are also the keys a calibrated
+//   sensor file may carry in its "physics" object (SensorConfig::physics).
+#include <map>
 #include <string>
 #include <vector>
 
@@ -38,6 +46,17 @@ struct PhysicsConfig {
   void save(const std::string& path) const;
   /// Names of the effects that are on, in catalogue order.
   std::vector<std::string> activeEffects() const;
+  /// This configuration with a sensor's appearance physics (SensorConfig::physics) added for
+  /// every key it does not set itself (an explicit value, 0 too, wins).
+  PhysicsConfig withSensorPhysics(const std::map<std::string, double>& sensor_physics) const;
 };
+
+/// Physics keys a sensor file may carry ("physics": {...}): the appearance effects of a sensor's
+/// recordings that `spinradar diagnose` fits (glint, glint_across, glint_along, azimuth_jitter).
+extern const std::vector<std::string> kSensorPhysicsKeys;
+
+/// The "physics" object of a sensor file, range-checked as physics keys; an unknown key or a
+/// bad value throws naming "physics/<key>".
+std::map<std::string, double> sensorPhysicsFromJson(const nlohmann::json& j);
 
 }  // namespace spinradar::sim

@@ -1,5 +1,6 @@
 #pragma once
 // Sensor model parameters (Navtech CIR204-H defaults). One definition, like params.hpp.
+#include <map>
 #include <string>
 #include <vector>
 
@@ -66,6 +67,11 @@ namespace spinradar::sim {
 
 struct SensorConfig {
   SPINRADAR_DECLARE_PARAMS(SPINRADAR_SENSOR_PARAMS)
+  /// Appearance physics of this sensor's recordings (file key "physics": physics keys
+  /// kSensorPhysicsKeys, defined and range-checked in physics.cpp), applied by the simulator
+  /// unless its physics configuration sets the key. Empty (the default): no effect, and the
+  /// sensor file has no "physics" entry.
+  std::map<std::string, double> physics;
   void validate() const;  ///< throws std::invalid_argument naming the parameter
   /// {"name": value, ...} for every parameter; fromJson takes a subset (unknown keys rejected).
   nlohmann::json toJson() const;
