@@ -78,7 +78,10 @@ cols_spec=(
   # real returns matched between scans spread 0.15-0.25 m across the beam, the simulator's
   # without glint 0.05-0.07 m (docs/diagnose_glint.md; fitted Oxford 0.09-0.14, RADIATE 0.18).
   "city_glint0.14|city|0|{}|1|no|\"glint\": 0.14"
-  "city_oxford_glint0.14|city|0|@oxford|1|no|\"glint\": 0.14"
+  # The calibrated files carry the glint terms fitted on the real samples (physics block of
+  # config/sensors, eighth round): city_oxford and city_radiate have them; this column keeps
+  # the seventh round's isotropic 0.14 m instead, with the file's terms set to 0.
+  "city_oxford_glint0.14|city|0|@oxford|1|no|\"glint\": 0.14, \"glint_across\": 0, \"glint_along\": 0, \"azimuth_jitter\": 0"
   "out_and_back_glint0.18|out_and_back|0|{}|1|yes|\"glint\": 0.18"
 )
 # "@name": the calibrated model config/sensors/name.json.

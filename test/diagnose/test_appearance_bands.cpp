@@ -192,7 +192,9 @@ TEST(AppearanceBands, ConcealedDarkFarNoiseFittedByZeroShare) {
       std::cerr << "hidden " << hidden << ": noise node 71 m " << fitted.stc_curve_db_71m
                 << ", zeros 50-100 m real " << real.band_zero[3] << " fitted " << after.band_zero[3]
                 << ", floor real " << real.band_floor[3] << "\n";
-    if (hidden < 0) EXPECT_GT(real.band_zero[3], 0.5);  // the floor figure is blind here
+    if (hidden < 0) {
+      EXPECT_GT(real.band_zero[3], 0.5);  // the floor figure is blind here
+    }
     EXPECT_NEAR(fitted.stc_curve_db_71m, hidden, 1.0) << hidden;
     EXPECT_NEAR(after.band_zero[3], real.band_zero[3], 0.1 * real.band_zero[3]) << hidden;
   }
