@@ -48,6 +48,7 @@ struct FrameBuffer {
 
   void copyFrom(const FeatureFrame& src) {
     frame.stamp_ns = src.stamp_ns;
+    frame.period_ns = src.period_ns;
     frame.keypoints.assign(src.keypoints.begin(), src.keypoints.end());
     const cv::Mat& d = src.descriptors;
     if (d.empty()) {

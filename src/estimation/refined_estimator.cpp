@@ -8,6 +8,7 @@
 #include <Eigen/LU>
 
 #include "spinradar/estimation/doppler.hpp"
+#include "spinradar/estimation/scan_period.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/core/normal_equations.hpp"
 
@@ -152,9 +153,20 @@ bool RefinedEstimator::estimate(const FeatureFrame& f1, const FeatureFrame& f2,
   // 6. Standing still.
   if (xi.head<2>().norm() < kStillSpeed && xi.dot(cov.ldlt().solve(xi)) < 11.34 /* chi2_3 99% */)
     xi.setZero();
-  // 5. Lag-free T_12 from the mean of the previous and current pair velocities.
-  if (has_prev_) {
+  // 5. Lag-free T_12 from the previous and current pair velocities, interpolated to the
+  //    step's middle: their mean while no scan is missing; after a dropped scan (or on a
+  //    recording read every other scan) the current pair weighs more, as each pair's centre
+  //    is half a rotation period, not half a step, after its step's middle (scan_period.hpp).
+  //    The mean there lagged by a quarter step less half a period (0.125 s at 2 Hz of a 4 Hz
+  //    sensor): at a turn entry the step came out 4-5 deg short, and the keyframe
+  //    estimator's prior with it (issue 19).
+  const double w_prev =
+      ScanPeriod::earlierPairWeight(prev_step_, dt_ref, ScanPeriod::rotation(f2));
+  if (has_prev_ && w_prev == 0.5) {
     setMotionFromVelocity(0.5 * (prev_xi_ + xi), 0.5 * (prev_cov_ + cov), dt_ref, out);
+  } else if (has_prev_) {
+    setMotionFromVelocity(w_prev * prev_xi_ + (1.0 - w_prev) * xi,
+                          w_prev * prev_cov_ + (1.0 - w_prev) * cov, dt_ref, out);
   } else {
     setMotionFromVelocity(xi, cov, dt_ref, out);
   }
@@ -170,6 +182,7 @@ bool RefinedEstimator::estimate(const FeatureFrame& f1, const FeatureFrame& f2,
   prev_xi_ = xi;
   prev_cov_ = cov;
   prev_ref2_ = ref2;
+  prev_step_ = dt_ref;
   has_prev_ = true;
   return true;
 }

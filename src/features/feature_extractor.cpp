@@ -55,6 +55,7 @@ void FeatureExtractor::extract(const PolarScan& scan, FeatureFrame& out, StageTi
       out.stamp_ns = scan.stamp_ns[a];
       break;
     }
+  out.period_ns = rotationPeriodNs(scan);
   const auto t0 = Clock::now();
   m.detector.detect(scan, out.keypoints);
   const auto t1 = Clock::now();

@@ -1,5 +1,6 @@
 #include "spinradar_ros/conversions.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -53,6 +54,7 @@ void toMsg(const spinradar::FeatureFrame& frame, int64_t scan_end_ns, const std:
   msg.header.stamp = toRosTime(frame.stamp_ns);
   msg.header.frame_id = frame_id;
   msg.scan_end = toRosTime(scan_end_ns);
+  msg.rotation_period.fromNSec(frame.period_ns > 0 ? frame.period_ns : 0);
   const size_t n = frame.keypoints.size();
   msg.keypoints.resize(n);
   for (size_t i = 0; i < n; ++i) {
@@ -91,6 +93,7 @@ void fromMsg(const spinradar::Features& msg, spinradar::FeatureFrame& frame) {
                              " descriptor bytes for " + std::to_string(n) + " keypoints x " +
                              std::to_string(size) + " bytes");
   frame.stamp_ns = toNs(msg.header.stamp);
+  frame.period_ns = std::max<int64_t>(0, static_cast<int64_t>(msg.rotation_period.toNSec()));
   frame.keypoints.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const auto& m = msg.keypoints[i];

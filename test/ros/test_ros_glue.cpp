@@ -100,6 +100,7 @@ TEST(Reconfigure, CopiesByNameAndRejectsInvalid) {
 TEST(Conversions, FeaturesRoundTrip) {
   spinradar::FeatureFrame f;
   f.stamp_ns = 1700000000123456789LL;
+  f.period_ns = 250000000;  // the rotation period goes along (dropped scans, issue 19)
   for (int i = 0; i < 5; ++i) {
     spinradar::Keypoint k;
     k.range = 10 + i;
@@ -122,6 +123,7 @@ TEST(Conversions, FeaturesRoundTrip) {
   spinradar::FeatureFrame back;
   spinradar_ros::fromMsg(msg, back);
   EXPECT_EQ(back.stamp_ns, f.stamp_ns);
+  EXPECT_EQ(back.period_ns, f.period_ns);
   ASSERT_EQ(back.keypoints.size(), 5u);
   EXPECT_EQ(back.keypoints[3].stamp_ns, f.keypoints[3].stamp_ns);
   EXPECT_EQ(back.keypoints[3].bin, f.keypoints[3].bin);

@@ -21,6 +21,10 @@ struct Keypoint {
 /// Features of one scan: keypoints, one descriptor row per keypoint.
 struct FeatureFrame {
   int64_t stamp_ns = 0;            ///< reference time of the scan (first valid azimuth)
+  /// The sensor's rotation period (ns) from the scan's row stamps (rotationPeriodNs in
+  /// polar_scan.hpp); 0 = unknown (frames built without a scan). Not the stamp step to the
+  /// previous scan, which is two periods after a dropped scan (scan_period.hpp).
+  int64_t period_ns = 0;
   std::vector<Keypoint> keypoints;
   cv::Mat descriptors;             ///< keypoints.size() x D, CV_8U (ORB: D = 32)
 };

@@ -42,4 +42,28 @@ struct PolarScan {
   bool empty() const { return azimuths == 0 || bins == 0; }
 };
 
+/// The sensor's rotation period (ns) told by a scan's own row stamps: the least-squares stamp
+/// step per row over the valid rows, times the rows of one rotation (`azimuths`). A line, not
+/// the first-to-last span: Oxford and MulRan stamps are packet arrival times, in bursts. This,
+/// not the stamp step to the previous scan, is the period: after a dropped scan, or on a
+/// recording read every other scan, the step is two periods (issue 19). 0 when it cannot be
+/// told (fewer than two valid rows, or stamps not increasing).
+inline int64_t rotationPeriodNs(const PolarScan& scan) {
+  const int n = static_cast<int>(scan.stamp_ns.size());
+  const bool flags = scan.valid.size() == scan.stamp_ns.size();
+  if (n < 2 || scan.azimuths < 2) return 0;
+  const int64_t t0 = scan.stamp_ns.front();
+  double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (int a = 0; a < n; ++a) {
+    if (flags && !scan.valid[a]) continue;
+    const double x = a, y = static_cast<double>(scan.stamp_ns[a] - t0);
+    sw += 1; sx += x; sy += y; sxx += x * x; sxy += x * y;
+  }
+  const double den = sw * sxx - sx * sx;
+  if (sw < 2 || !(den > 0)) return 0;
+  const double per_row = (sw * sxy - sx * sy) / den;
+  const double period = per_row * scan.azimuths;
+  return period > 0 && period < 9.2e18 ? static_cast<int64_t>(period + 0.5) : 0;
+}
+
 }  // namespace spinradar

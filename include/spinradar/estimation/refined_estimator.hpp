@@ -20,9 +20,11 @@
 //  4. A weak constant-velocity prior on the change from the previous pair (white-noise
 //     acceleration), which only matters where the geometry is degenerate.
 //  5. Lag-free compounding: a pair's constant velocity describes [t1, t2 + period], centred
-//     half a scan after the interval between the reference times; T_12 instead uses the
-//     mean of the previous and current pair velocities (linear interpolation between their
-//     centres), which removes the ~0.125 s lag of frame-to-frame compounding.
+//     half a rotation period after the interval between the reference times; T_12 instead
+//     interpolates the previous and current pair velocities linearly between their centres
+//     to the interval's middle (their mean while no scan is missing; after a dropped scan
+//     the current pair weighs more, ScanPeriod::earlierPairWeight), which removes the
+//     ~0.125 s lag of frame-to-frame compounding.
 //  6. Standing still: a velocity statistically indistinguishable from zero and slower than
 //     kStillSpeed is snapped to zero, so the pose does not drift while stopped.
 #include <cstdint>
@@ -61,6 +63,7 @@ class RefinedEstimator {
   McRansac mc_;
   bool has_prev_ = false;
   int64_t prev_ref2_ = 0;
+  double prev_step_ = 0.0;  ///< the previous pair's stamp step (s), for the interpolation (5.)
   Eigen::Vector3d prev_xi_ = Eigen::Vector3d::Zero();
   Eigen::Matrix3d prev_cov_ = Eigen::Matrix3d::Identity();
   double prior_dt_ = 0.25;
