@@ -20,6 +20,8 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   last_stamp_ = cur.stamp_ns;
   has_last_stamp_ = true;
   const double c = kMidScan * scan_period_.update(cur, dt);  // mid-scan, see ScanPeriod
+  // A dropped scan (or a recording read every other scan): the step is a gap (scan_period.hpp).
+  const bool gap_step = has_key_ && ScanPeriod::isGap(dt, ScanPeriod::rotation(cur));
   // The pair velocity's yaw rate changed by over kRampYawAccel in the last scan (a ramp).
   const bool pair_ramp = std::abs(pair.velocity(2) - prev_pair_xi_(2)) > kRampYawAccel * dt;
   row_step_ = rowQuantization(cur);
@@ -31,6 +33,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     key_xi_cov_ = pair.velocity_cov;
     makeKeyframe(cur, pair.velocity, c, T_w, P);
     key_pair_xi_ = pair.velocity;
+    key_ramp_ = false;
     P_jm_ = P;
     prev_c_ = c;
     prev_xi_ = prev_pair_xi_ = pair.velocity;
@@ -205,21 +208,21 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
       // map was moved with it), so keyframes taken one after another passed it on and it
       // grew (city_narrow straight, 14 s: 0.02 -> 0.13 rad/s, the truth 0). Both thresholds
       // are about 10x the scan-to-scan noise on straights.
-      // A keyframe whose map was moved with its registration's velocity, not its pair's (taken
-      // in a ramp, a turn exit, or after such a registration) holds that velocity's error in
-      // its map, and a registration's yaw rate follows the map's: the scans after it, on a
-      // straight, came out 0.08-0.16 rad/s off (truth 0, pair 0) and passed that on to the
-      // next keyframes (city_narrow layout 2: 1 deg in the chain over 7 s). So the
+      // A keyframe taken in a ramp (turn exit) holds the ramp's velocity error in its map, and
+      // a registration's yaw rate follows the map's: the scans after it, on a straight, came
+      // out 0.08-0.16 rad/s off (truth 0, pair 0) and passed that on to the next keyframes
+      // (city_narrow layout 2: 1 deg in the chain over 7 s). Against such a keyframe the
       // registration's yaw rate must also differ from the pair's by the gap relative to the
-      // keyframe's own (registered minus pair velocity at the keyframe) to count. This was
-      // only after a ramp keyframe; every other scan (dropped scans, issue 19) most scans
-      // become keyframes after weak registrations and the offset was passed on at every scan
-      // (skip_city_oxford, a straight at t = 18-21 s: -0.06 -> -0.15 rad/s, truth 0).
-      // Every other scan, keyframe+peaks: skip_city_oxford 4.97 -> 2.23 %, skip_city_mulran
-      // 0.66 -> 0.38, skip_city_wide 0.26 -> 0.12 (see docs/dropped_scans.md); every scan:
-      // the matrix unchanged but city_radiate 0.0807 -> 0.0800 % and out_and_back_glint0.18.
+      // keyframe's own (registered minus pair velocity at the keyframe) to count.
+      // The same across a dropped scan (a step of two periods, issue 19): every other scan,
+      // most scans become keyframes after weak registrations and the offset was passed on at
+      // every scan (skip_city_oxford, a straight at t = 18-21 s: -0.06 -> -0.15 rad/s, truth
+      // 0). Every other scan, keyframe+peaks: skip_city_oxford 4.97 -> 2.23 %,
+      // skip_city_mulran 0.66 -> 0.38, skip_city_wide 0.26 -> 0.12 (docs/dropped_scans.md).
+      // Not after every keyframe at 4 Hz: city_narrow layout 2 0.14 -> 0.19 % that way.
       double gap = std::abs(xi(2) - pair.velocity(2));
-      gap = std::min(gap, std::abs((xi(2) - key_xi_(2)) - (pair.velocity(2) - key_pair_xi_(2))));
+      if (key_ramp_ || gap_step)
+        gap = std::min(gap, std::abs((xi(2) - key_xi_(2)) - (pair.velocity(2) - key_pair_xi_(2))));
       if (gap > kRegisteredYawRateGap || pair_ramp) {
         xi_key = xi;
         xi_cov_pub = cov_pub.bottomRightCorner<3, 3>();
@@ -322,6 +325,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     key_xi_cov_(2, 2) += dw2 / 3.0;  // as above: the keyframe map was moved with that yaw rate
     makeKeyframe(cur, xi_key, c, T_w, P);
     key_pair_xi_ = pair.velocity;
+    key_ramp_ = pair_ramp;
     P_jm_ = P_m_next;
     key_accel_ = accel_;  // the acceleration its map was built under
   } else {

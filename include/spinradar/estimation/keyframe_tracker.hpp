@@ -137,8 +137,10 @@ class KeyframeTracker {
   static constexpr double kLastResortChi2 = 11.34;
   /// The registration's own velocity moves the scan's frame and map when its yaw rate is
   /// this far (rad/s) from the pair velocity's, or the pair velocity's yaw rate changed by
-  /// over kRampYawAccel (rad/s^2) in the last scan; the pair velocity otherwise. The gap also
-  /// counts relative to the keyframe's own (keyframe_tracker.cpp).
+  /// over kRampYawAccel (rad/s^2) in the last scan; the pair velocity otherwise. After a
+  /// keyframe taken in such a ramp, and across a dropped scan (a step of two rotation
+  /// periods, ScanPeriod::isGap), the gap also counts relative to the keyframe's own
+  /// (keyframe_tracker.cpp).
   static constexpr double kRegisteredYawRateGap = 0.05;
   static constexpr double kRampYawAccel = 0.1;
   static constexpr double kInlierRatio = 0.5;  ///< new keyframe below this x first count
@@ -212,9 +214,10 @@ class KeyframeTracker {
   int min_inliers_ = kMinInliers;  ///< solve()'s inlier minimum (kMinWeakInliers for a retry)
   Eigen::Vector3d prev_pair_xi_ = Eigen::Vector3d::Zero();  ///< the previous scan's pair velocity
   int key_inliers_ = 0;
-  /// The pair velocity at the keyframe's scan: with key_xi_, the offset of the registered
-  /// yaw rate its map was moved with (the registered yaw rate's reference, see track()).
+  /// The pair velocity at the keyframe's scan, and whether the pair's yaw rate was ramping
+  /// there (kRampYawAccel): the registered yaw rate's reference after such a keyframe.
   Eigen::Vector3d key_pair_xi_ = Eigen::Vector3d::Zero();
+  bool key_ramp_ = false;
   int64_t key_stamp_ = 0, rel_key_stamp_ = 0;
   /// The keyframe's velocity covariance (published one): its map's own uncertainty.
   Eigen::Matrix3d key_xi_cov_ = Eigen::Matrix3d::Zero();
