@@ -99,8 +99,11 @@ TEST(OdometryDroppedScans, WeakRegistrationsDoNotPassAYawRateOn) {
   physics.doppler = 0.049;
   physics.moving_objects = true;
   const sim::Scene sc = sim::builtinScene("city", 0);
-  const sim::SensorConfig oxford =
-      sim::SensorConfig::load(std::string(SPINRADAR_SOURCE_DIR) + "/config/sensors/oxford.json");
+  // The Oxford model as calibrated at main b0cda56 (config/sensors/oxford.json then), kept
+  // here so the test does not move with recalibration (as test_near_band does): with the
+  // regenerated file (glint terms) the old rule reached only 1.47 deg against 1.11.
+  const sim::SensorConfig oxford = sim::SensorConfig::load(
+      std::string(SPINRADAR_SOURCE_DIR) + "/test/sim/dropped_scans_oxford_sensor.json");
   const sim::Simulator s(sc.world, sc.trajectory, oxford, physics, 1);
   const DriveErrors full = drive(s, sc.trajectory, 40, 102, 1, "city layout 0, Oxford model");
   const DriveErrors skip = drive(s, sc.trajectory, 40, 102, 2, "city layout 0, Oxford model");
