@@ -136,13 +136,8 @@ std::string glintTable(const GlintFit& f) {
   std::ostringstream os;
   os.setf(std::ios::fixed);
   os.precision(3);
-  os << "| spread across / along the beam, m | 2.5-10 m | 10-25 m | 25-50 m | 50-100 m | all |\n"
-        "|---|---|---|---|---|---|\n";
-  auto row = [&](const std::string& name, const MatchedSpread& m) {
-    os << "| " << name << " (" << m.pairs << " pairs) |";
-    for (const auto& b : m.band) os << " " << b.tangential << " / " << b.radial << " |";
-    os << " " << m.all.tangential << " +- " << m.all.tangential_se << " / " << m.all.radial << " |\n";
-  };
+  writeSpreadTableHeader(os);
+  auto row = [&](const std::string& name, const MatchedSpread& m) { writeSpreadTableRow(os, name, m); };
   row("recording", f.real);
   if (f.before.pairs) row("model, glint " + std::to_string(f.base).substr(0, 5) + " m", f.before);
   if (f.named) row("model, glint " + std::to_string(f.value).substr(0, 5) + " m (fitted)", f.after);

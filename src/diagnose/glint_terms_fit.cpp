@@ -208,13 +208,9 @@ std::string glintTermsTable(const GlintTermsFit& f) {
        << t->size_unit << " | " << std::setprecision(0) << 100 * t->drop << " % | " << t->verdict
        << " |\n"
        << std::setprecision(3);
-  os << "\n| spread across / along the beam, m | 2.5-10 m | 10-25 m | 25-50 m | 50-100 m | all |\n"
-        "|---|---|---|---|---|---|\n";
-  auto row = [&](const std::string& name, const MatchedSpread& m) {
-    os << "| " << name << " (" << m.pairs << " pairs) |";
-    for (const auto& b : m.band) os << " " << b.tangential << " / " << b.radial << " |";
-    os << " " << m.all.tangential << " +- " << m.all.tangential_se << " / " << m.all.radial << " |\n";
-  };
+  os << "\n";
+  writeSpreadTableHeader(os);
+  auto row = [&](const std::string& name, const MatchedSpread& m) { writeSpreadTableRow(os, name, m); };
   row("recording", f.real);
   if (f.base.pairs) row("model, terms 0", f.base);
   if (f.after.pairs && !f.named().empty()) row("model, named terms", f.after);

@@ -295,4 +295,15 @@ MatchedSpread measureMatchedSpread(const std::vector<PolarScan>& scans,
   return out;
 }
 
+void writeSpreadTableHeader(std::ostream& os) {
+  os << "| spread across / along the beam, m | 2.5-10 m | 10-25 m | 25-50 m | 50-100 m | all |\n"
+        "|---|---|---|---|---|---|\n";
+}
+
+void writeSpreadTableRow(std::ostream& os, const std::string& name, const MatchedSpread& m) {
+  os << "| " << name << " (" << m.pairs << " pairs) |";
+  for (const auto& b : m.band) os << " " << b.tangential << " / " << b.radial << " |";
+  os << " " << m.all.tangential << " +- " << m.all.tangential_se << " / " << m.all.radial << " |\n";
+}
+
 }  // namespace spinradar::diagnose

@@ -7,6 +7,8 @@
 // azimuth), the strongest fraction of each band. Motion: given, or estimated per pair by a
 // coarse correlation search then point-to-point ICP (diagnose may not use the estimation part).
 #include <array>
+#include <ostream>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -59,5 +61,10 @@ MatchedSpread measureMatchedSpread(const std::vector<PolarScan>& scans,
 Eigen::Matrix3d alignReturns(const std::vector<Eigen::Vector2d>& a,
                              const std::vector<Eigen::Vector2d>& b, const Eigen::Matrix3d& init,
                              const SpreadOptions& opt = {});
+
+/// Markdown table of matched spreads per range band (across / along the beam, m): the header,
+/// then one row per spread, in the stream's current number format.
+void writeSpreadTableHeader(std::ostream& os);
+void writeSpreadTableRow(std::ostream& os, const std::string& name, const MatchedSpread& m);
 
 }  // namespace spinradar::diagnose
