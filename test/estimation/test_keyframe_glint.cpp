@@ -11,11 +11,13 @@
 #include <iostream>
 #include <random>
 
+#include "support/noisy_prior.hpp"
 #include "support/synthetic_scene.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/estimation/keyframe_tracker.hpp"
 
 using namespace spinradar;
+using spinradar::testing::NoisyPrior;
 using spinradar::testing::SceneOptions;
 using spinradar::testing::SyntheticScene;
 
@@ -49,23 +51,13 @@ Drive drive(uint32_t seed, double glint, int submap, double floor_gate, int scan
   cfg.submap_keyframes = submap;
   cfg.floor_gate = floor_gate;
   KeyframeTracker kt(cfg);
-  std::mt19937 rng(seed + 7);
-  std::normal_distribution<double> nr(0.0, 1.0);
-  const double sxy = 0.02, syaw = 0.1 * kDeg, sv = 0.02, sw = 0.001;
+  NoisyPrior prior(seed + 7);
   Eigen::Matrix3d T_w = Eigen::Matrix3d::Identity(), P = Eigen::Matrix3d::Zero();
   Drive run;
   double sum2 = 0.0, nees = 0.0;
   for (int k = 0; k < scans; ++k) {
     const FeatureFrame f = scene.observe(k);
-    MotionEstimate pair;
-    pair.ok = true;
-    pair.T_12 = Eigen::Matrix3d::Identity();
-    if (k > 0)
-      pair.T_12 = scene.relative(k - 1, k) *
-                  se2::exp(Eigen::Vector3d(sxy * nr(rng), sxy * nr(rng), syaw * nr(rng)));
-    pair.T_12_cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
-    pair.velocity = v + Eigen::Vector3d(sv * nr(rng), sv * nr(rng), sw * nr(rng));
-    pair.velocity_cov = Eigen::Vector3d(sv * sv, sv * sv, sw * sw).asDiagonal();
+    MotionEstimate pair = prior(scene, k, v);
     const Eigen::Matrix3d T_prev = T_w, P_prev = P;
     kt.track(f, T_prev, P_prev, 0.8, pair, T_w, P);
     const Eigen::Matrix3d truth = scene.relative(0, k);
