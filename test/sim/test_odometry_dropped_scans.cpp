@@ -30,6 +30,15 @@ struct DriveErrors {
   double path = 0.0;        ///< m, true path length
 };
 
+/// The matrix's full physics: motion distortion, Doppler beta 0.049 s, moving cars.
+sim::PhysicsConfig fullPhysics() {
+  sim::PhysicsConfig physics;
+  physics.motion_distortion = true;
+  physics.doppler = 0.049;
+  physics.moving_objects = true;
+  return physics;
+}
+
 /// Scans k0, k0 + stride, ... up to k1 of city layout 0 with full physics through the default
 /// pipeline; the accumulated pose (relative to the first scan) against the truth.
 DriveErrors drive(const sim::Simulator& s, const sim::Trajectory& traj, int k0, int k1, int stride,
@@ -68,10 +77,7 @@ DriveErrors drive(const sim::Simulator& s, const sim::Trajectory& traj, int k0, 
 }  // namespace
 
 TEST(OdometryDroppedScans, EveryOtherScanDriftsAsLittleAsEveryScan) {
-  sim::PhysicsConfig physics;
-  physics.motion_distortion = true;
-  physics.doppler = 0.049;
-  physics.moving_objects = true;
+  const sim::PhysicsConfig physics = fullPhysics();
   const sim::Scene sc = sim::builtinScene("city", 0);
   const sim::Simulator s(sc.world, sc.trajectory, sim::SensorConfig{}, physics, 1);
   // t = 55..77 s: two right-angle right turns (58-61 s, 72-75 s) and the straights around.
@@ -94,10 +100,7 @@ TEST(OdometryDroppedScans, WeakRegistrationsDoNotPassAYawRateOn) {
   // Every other scan without that: worst yaw error 2.0 deg (1.8 deg for 3 s on the
   // straight); with it 0.62 deg; every scan 0.33 deg. (The turn exit that follows, t = 26 s,
   // still puts 4.8 deg into the chain every other scan under this model: docs/dropped_scans.md.)
-  sim::PhysicsConfig physics;
-  physics.motion_distortion = true;
-  physics.doppler = 0.049;
-  physics.moving_objects = true;
+  const sim::PhysicsConfig physics = fullPhysics();
   const sim::Scene sc = sim::builtinScene("city", 0);
   // The Oxford model as calibrated at main b0cda56 (config/sensors/oxford.json then), kept
   // here so the test does not move with recalibration (as test_near_band does): with the
