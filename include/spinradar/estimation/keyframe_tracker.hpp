@@ -139,8 +139,8 @@ class KeyframeTracker {
   /// this far (rad/s) from the pair velocity's, or the pair velocity's yaw rate changed by
   /// over kRampYawAccel (rad/s^2) in the last scan; the pair velocity otherwise. After a
   /// keyframe taken in such a ramp, and across a dropped scan (a step of two rotation
-  /// periods, ScanPeriod::isGap), the gap also counts relative to the keyframe's own
-  /// (keyframe_tracker.cpp).
+  /// periods, ScanPeriod::isGap), the gap also counts relative to the keyframe's own; and it
+  /// must also be EstimatorConfig::yaw_rate_sigmas standard deviations (keyframe_tracker.cpp).
   static constexpr double kRegisteredYawRateGap = 0.05;
   static constexpr double kRampYawAccel = 0.1;
   static constexpr double kInlierRatio = 0.5;  ///< new keyframe below this x first count
