@@ -5,7 +5,7 @@
 // Within one scan the yaw rate trades against the yaw, so where the returns scatter across
 // the beam (real RADIATE scans: tangential floor 0.04-0.2 m, azimuth jitter 0.29 deg) the
 // registration measures it to 0.02-0.07 rad/s (its covariance), and 0.05 rad/s of noise
-// there moved the published yaw by 0.36 deg for one scan (RADIATE consistency, skip run 1,
+// there moved the published yaw by 0.57 deg for one scan (RADIATE consistency, skip run 1,
 // scan 12: 0.079 rad/s off the pair's, 2.2 sigma). yaw_rate_sigmas: the difference must also
 // be that many of its standard deviations. Known truth: a synthetic drive at 2 Hz (a 4 Hz
 // sensor read every other scan, as the consistency column's direct runs) with returns
