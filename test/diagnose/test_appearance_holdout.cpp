@@ -99,6 +99,13 @@ TEST(AppearanceHoldout, NoisierHeldOutReceiverIsTheModel) {
       ++model;
     }
   EXPECT_GE(model, 3);
+  // A receiver change moves the background of every sector alike.
+  for (int k = 1; k < kBands; ++k) {
+    const SectorShift sh = rep.floor_shifts[size_t(k)];
+    std::cout << "  band " << k << " background shift " << sh.lo << " .. " << sh.hi << " (" << sh.common << ")\n";
+    EXPECT_GT(sh.common, 2.0) << k;
+    EXPECT_GT(sh.lo, 1.0) << k;
+  }
 }
 
 TEST(AppearanceHoldout, NullCarriesOver) {
@@ -112,6 +119,15 @@ TEST(AppearanceHoldout, NullCarriesOver) {
       EXPECT_LE(std::abs(f.carry), 0.10) << f.name;
       EXPECT_LE(f.gap_holdout, 0.15) << f.name;
     }
+  for (int k = 1; k < kBands; ++k) EXPECT_LT(std::abs(rep.floor_shifts[size_t(k)].common), 1.0) << k;
+}
+
+// One scan split by quarters: the parts share no azimuth sector, no shift is measured.
+TEST(AppearanceHoldout, QuarterSplitHasNoSectorShift) {
+  const sim::SensorConfig s = testing::hundredMetreSensor();
+  std::vector<PolarScan> fit, holdout;
+  splitHoldout(render("out_and_back", s, {300}, 3), fit, holdout);
+  EXPECT_TRUE(std::isnan(sectorFloorShift(fit, holdout, 2).common));
 }
 
 TEST(AppearanceHoldout, Verdicts) {

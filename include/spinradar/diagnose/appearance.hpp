@@ -163,6 +163,17 @@ bool isSceneDependent(int band, const std::string& figure);
 std::vector<std::pair<std::string, double>> fittedBandGaps(const sim::RealismStats& sim,
                                                            const sim::RealismStats& real);
 
+/// How the background (mean of the lower half of the counts) of one range band moved from the
+/// fit part to the held-out part, per azimuth sector: the median shift over the sectors
+/// (common: a receiver change moves every sector alike) and the lowest and highest (diffuse scene
+/// content moves them apart). Counts; NaN when the parts share no sector (one scan split by
+/// quarters).
+struct SectorShift {
+  double common = NAN, lo = NAN, hi = NAN;
+};
+SectorShift sectorFloorShift(const std::vector<PolarScan>& fit,
+                             const std::vector<PolarScan>& holdout, int band, int sectors = 8);
+
 /// One fitted figure on the held-out part, and why it is off (classifyHeldOutFigure): the
 /// fitted sensor against the held-out part with the fit's reference scene, with the fit part's
 /// and the held-out part's own scenes (detail::holdoutSceneCheck), and the real halves' own
@@ -177,12 +188,17 @@ struct HeldOutFigure {
   double carry = NAN;
   /// The held-out gap net of the parts' different content: |sim / real_fit x (1 + carry) - 1|.
   double gap_net = NAN;
+  SectorShift floor_shift;        ///< of the figure's band
+  bool background_moves = false;  ///< sectors apart by 2 dB or more, common shift under 1 dB
   std::string verdict;
 };
 /// "model" when the fit part is off by over 15 % too, or the fitted sensor does over 10 % worse
-/// on the held-out part's own scene than on the fit part's (carry); "scene" otherwise (the
-/// parts show different content); without the own-scene renders, "the real halves' own
-/// difference" when the halves differ about as much as the held-out gap.
+/// on the held-out part's own scene than on the fit part's (carry) while the band's background
+/// shifts alike in every sector; "scene below the own scene's margin" when the carry-over is
+/// over 10 % but the background moves sector by sector (diffuse content the own scene, made of
+/// returns 10 dB over the floor, does not hold); "scene" otherwise (the parts show different
+/// content); without the own-scene renders, "the real halves' own difference" when the halves
+/// differ about as much as the held-out gap.
 std::string classifyHeldOutFigure(const HeldOutFigure& f);
 
 struct AppearanceReport {
@@ -204,6 +220,7 @@ struct AppearanceReport {
   /// worst gaps against those parts, and every fitted figure of the held-out part with its verdict.
   sim::RealismStats realism_fit_scene, realism_holdout_scene;
   double worst_fit_scene = 0, worst_holdout_scene = 0, worst_net = 0;
+  std::array<SectorShift, kBands> floor_shifts;  ///< per band
   std::vector<HeldOutFigure> held_out_figures;
   double runtime_s = 0;
   nlohmann::json toJson() const;
