@@ -396,8 +396,6 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
   rep.fitted_physics = phys;
   detail::locateAppearance(rep);
   if (opt.realism) detail::realismBeforeAfter(real, holdout, opt, rep);
-  if (opt.realism && opt.holdout_scene_check && !holdout.empty())
-    detail::holdoutSceneCheck(real, holdout, opt, rep);
   rep.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return rep;
 }

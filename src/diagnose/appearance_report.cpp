@@ -86,6 +86,7 @@ void realismBeforeAfter(const std::vector<PolarScan>& real, const std::vector<Po
   if (!holdout.empty()) {
     rep.worst_holdout_before = worst(fittedBandGaps(rep.realism_before, rep.realism_holdout));
     rep.worst_holdout_after = worst(fittedBandGaps(rep.realism_after, rep.realism_holdout));
+    if (opt.holdout_scene_check) holdoutSceneCheck(real, holdout, opt, rep);
   }
 }
 
