@@ -96,6 +96,14 @@ def main():
                              (f" (halves differ {100 * halves[n]:.0f} %)" if n in halves else "")
                              for n, x in over) or "none"
             print(f"- {label}, {what}: over 15 % (real halves' own difference): {text}")
+        # Held-out check with each part's own scene (appearance_holdout.cpp): the verdicts.
+        verdicts = {f["figure"]: f for f in j.get("held_out_figures", [])}
+        for n, x in sorted(gaps(j, "recording_holdout", "sim_after").items() if verdicts else [],
+                           key=lambda t: -t[1]):
+            if x > 0.15 and n in verdicts:
+                f = verdicts[n]
+                print(f"  - {label}, held out {n}: carry-over {100 * f['carry']:.1f} %, "
+                      f"net of the scene {100 * f['gap_net']:.1f} %: {f['verdict']}")
     if any("recording_holdout" in j["realism_bands"] for _, j in reps):
         print()
         print("| real data's own split-half difference, 10-100 m (largest, figure) | " +

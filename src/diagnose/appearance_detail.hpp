@@ -44,6 +44,13 @@ void locateAppearance(AppearanceReport& rep);
 void realismBeforeAfter(const std::vector<PolarScan>& real, const std::vector<PolarScan>& holdout,
                         const AppearanceOptions& opt, AppearanceReport& rep);
 
+/// Renders rep.fitted with the fit part's and the held-out part's own scenes and classifies
+/// each held-out figure (appearance_holdout.cpp); the markdown section and JSON of it.
+void holdoutSceneCheck(const std::vector<PolarScan>& fit, const std::vector<PolarScan>& holdout,
+                       const AppearanceOptions& opt, AppearanceReport& rep);
+std::string holdoutSceneMarkdown(const AppearanceReport& rep);
+nlohmann::json holdoutSceneJson(const AppearanceReport& rep);
+
 bool physicsHasGhosts(const sim::PhysicsConfig& p);
 AppearanceFinding makeFinding(const std::string& effect, const std::string& param,
                               const std::string& unit, double base, double value, double sd,

@@ -86,6 +86,7 @@ void realismBeforeAfter(const std::vector<PolarScan>& real, const std::vector<Po
   if (!holdout.empty()) {
     rep.worst_holdout_before = worst(fittedBandGaps(rep.realism_before, rep.realism_holdout));
     rep.worst_holdout_after = worst(fittedBandGaps(rep.realism_after, rep.realism_holdout));
+    if (opt.holdout_scene_check) holdoutSceneCheck(real, holdout, opt, rep);
   }
 }
 
@@ -147,6 +148,14 @@ nlohmann::json AppearanceReport::toJson() const {
     j["fitted_figures_over_15_percent"] = {{"fit_part", over(realism_after, realism_real)}};
     if (!realism_holdout.name.empty())
       j["fitted_figures_over_15_percent"]["holdout_part"] = over(realism_after, realism_holdout);
+    if (!held_out_figures.empty()) {
+      j["realism_bands"]["sim_after_fit_scene"] = bands(realism_fit_scene);
+      j["realism_bands"]["sim_after_holdout_scene"] = bands(realism_holdout_scene);
+      j["held_out_figures"] = detail::holdoutSceneJson(*this);
+      j["worst_band_gap_fit_own_scene"] = worst_fit_scene;
+      j["worst_band_gap_holdout_own_scene"] = worst_holdout_scene;
+      j["worst_band_gap_holdout_net_of_scene"] = worst_net;
+    }
   }
   j["runtime_s"] = runtime_s;
   return j;
@@ -202,6 +211,7 @@ std::string AppearanceReport::summaryMarkdown() const {
     };
     over(realism_real, "fit part");
     if (!realism_holdout.name.empty()) over(realism_holdout, "held-out part");
+    os << "\n" << detail::holdoutSceneMarkdown(*this);
     os << "\n\n**Scene-dependent, not fitted** (real fit part / held out / sim before / after; "
           "why below):\n";
     const char* const band_names[kBands] = {"2.5-10 m", "10-25 m", "25-50 m", "50-100 m"};

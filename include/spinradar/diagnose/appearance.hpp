@@ -142,6 +142,9 @@ struct AppearanceOptions {
   bool fit_glint = true;
   /// Fit on part of the recording and check on the rest (splitHoldout).
   bool holdout = true;
+  /// Also render the fitted sensor with each part's own scene, to tell a held-out gap of the
+  /// scene from one of the sensor (detail::holdoutSceneCheck; needs realism and holdout).
+  bool holdout_scene_check = true;
 };
 
 /// A per-band realism figure that measures the reference scene's geometry rather than the
@@ -160,6 +163,44 @@ bool isSceneDependent(int band, const std::string& figure);
 std::vector<std::pair<std::string, double>> fittedBandGaps(const sim::RealismStats& sim,
                                                            const sim::RealismStats& real);
 
+/// How the background (mean of the lower half of the counts) of one range band moved from the
+/// fit part to the held-out part, per azimuth sector: the median shift over the sectors
+/// (common: a receiver change moves every sector alike) and the lowest and highest (diffuse scene
+/// content moves them apart). Counts; NaN when the parts share no sector (one scan split by
+/// quarters).
+struct SectorShift {
+  double common = NAN, lo = NAN, hi = NAN;
+};
+SectorShift sectorFloorShift(const std::vector<PolarScan>& fit,
+                             const std::vector<PolarScan>& holdout, int band, int sectors = 8);
+
+/// One fitted figure on the held-out part, and why it is off (classifyHeldOutFigure): the
+/// fitted sensor against the held-out part with the fit's reference scene, with the fit part's
+/// and the held-out part's own scenes (detail::holdoutSceneCheck), and the real halves' own
+/// difference |held out - fit part| / fit part.
+struct HeldOutFigure {
+  std::string name;  ///< "50-100 m cen2018"
+  double real_fit = NAN, real_holdout = NAN, sim = NAN, sim_fit_scene = NAN, sim_holdout_scene = NAN;
+  double gap_fit = NAN, gap_holdout = NAN, halves = NAN, gap_fit_scene = NAN, gap_holdout_scene = NAN;
+  /// Carry-over: (sim_holdout_scene / real_holdout) / (sim_fit_scene / real_fit) - 1, how much
+  /// worse (or better) the fitted sensor does on the held-out part than on the fit part when
+  /// each is rendered from its own scene (what the own scene itself misses cancels out).
+  double carry = NAN;
+  /// The held-out gap net of the parts' different content: |sim / real_fit x (1 + carry) - 1|.
+  double gap_net = NAN;
+  SectorShift floor_shift;        ///< of the figure's band
+  bool background_moves = false;  ///< sectors apart by 2 dB or more, common shift under 1 dB
+  std::string verdict;
+};
+/// "model" when the fit part is off by over 15 % too, or the fitted sensor does over 10 % worse
+/// on the held-out part's own scene than on the fit part's (carry) while the band's background
+/// shifts alike in every sector; "scene below the own scene's margin" when the carry-over is
+/// over 10 % but the background moves sector by sector (diffuse content the own scene, made of
+/// returns 10 dB over the floor, does not hold); "scene" otherwise (the parts show different
+/// content); without the own-scene renders, "the real halves' own difference" when the halves
+/// differ about as much as the held-out gap.
+std::string classifyHeldOutFigure(const HeldOutFigure& f);
+
 struct AppearanceReport {
   std::vector<AppearanceFinding> findings;  ///< named first (largest z), then the rest
   std::vector<AppearanceLocate> locate;
@@ -175,6 +216,12 @@ struct AppearanceReport {
   double worst_gap_before = 0, worst_gap_after = 0;
   double worst_holdout_before = 0, worst_holdout_after = 0;
   int fit_scans = 0, holdout_scans = 0;  ///< scans (or masked half scans) in each part
+  /// The fitted sensor rendered with the fit part's and the held-out part's own scenes, their
+  /// worst gaps against those parts, and every fitted figure of the held-out part with its verdict.
+  sim::RealismStats realism_fit_scene, realism_holdout_scene;
+  double worst_fit_scene = 0, worst_holdout_scene = 0, worst_net = 0;
+  std::array<SectorShift, kBands> floor_shifts;  ///< per band
+  std::vector<HeldOutFigure> held_out_figures;
   double runtime_s = 0;
   nlohmann::json toJson() const;
   std::string summaryMarkdown() const;
