@@ -95,7 +95,7 @@ GlintTermsFit fitGlintTerms(const std::vector<PolarScan>& recording, const sim::
   const MatchedSpread* anc = &f.base;
   Eigen::Vector2d xa = Eigen::Vector2d::Zero(), x = xa;
   Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-  double x3 = 0, s3 = 0;
+  double xa3 = 0, x3 = 0, s3 = 0;
   auto chi2 = [&](const Eigen::Vector2d& v) { return ((A * v - y).array().square() * w.array()).sum(); };
   auto single = [&](int c) {  // one term alone, non-negative
     Eigen::Vector2d v = Eigen::Vector2d::Zero();
@@ -125,6 +125,15 @@ GlintTermsFit fitGlintTerms(const std::vector<PolarScan>& recording, const sim::
         }
       }
     }
+    // Along: y_b = along_b^2 - anchor_b^2 = A (x3 - xa3).
+    double an = 0, ad = 0;
+    for (int b : bands) {
+      const SpreadBand &r = f.real.band[b], &b0 = anc->band[b];
+      const double wb = 1.0 / std::max(var(r.radial, r.radial_se, b0.radial, b0.radial_se), 1e-12);
+      an += wb * f.gain_along * (r.radial * r.radial - b0.radial * b0.radial + f.gain_along * xa3);
+      ad += wb * f.gain_along * f.gain_along;
+    }
+    x3 = std::max(0.0, an / ad), s3 = std::sqrt(1.0 / ad);
   };
   solve();
 
@@ -135,7 +144,7 @@ GlintTermsFit fitGlintTerms(const std::vector<PolarScan>& recording, const sim::
                                   f.gain_jitter * rr * rr * (x2 - xa(1)), 0.0));
   };
   auto along = [&](int b, double xv) {
-    return std::sqrt(std::max(std::pow(f.anchor_along.band[b].radial, 2) + f.gain_along * xv, 0.0));
+    return std::sqrt(std::max(std::pow(anc->band[b].radial, 2) + f.gain_along * (xv - xa3), 0.0));
   };
   auto resAcross = [&](double x1, double x2) {
     double s = 0;
@@ -161,6 +170,7 @@ GlintTermsFit fitGlintTerms(const std::vector<PolarScan>& recording, const sim::
     t.verdict = t.named ? "mismatch" : sig ? "negligible" : "not significant";
   };
   judge(f.across, x(0), std::sqrt(cov(0, 0)), 1.0, bin, dropOf(res, resAcross(0, x(1))));
+  judge(f.along, x3, s3, 1.0, bin, dropOf(resAlong(x3), resAlong(0)));
   if (jitter_ok) {
     judge(f.jitter, x(1), std::sqrt(std::max(cov(1, 1), 0.0)), 1.0 / kDeg, row,
           dropOf(res, resAcross(x(0), 0)));
@@ -175,38 +185,10 @@ GlintTermsFit fitGlintTerms(const std::vector<PolarScan>& recording, const sim::
         judge(f.jitter, x(1), std::sqrt(1.0 / nc), 1.0 / kDeg, row, dropOf(resAcross(0, x(1)), resAcross(0, 0)));
     }
   }
-  // Along: y_b = along_b^2 - anchor_b^2 = A x3 (x3 = glint_along^2), against the terms-0 render
-  // with the probe's gain. Option along_at_fit: against a render with the named across terms
-  // (they widen the along spread too: RADIATE sensor, city, 0.062 -> 0.078 m) and the gain taken
-  // again at the first fit (the added variance is not linear in x3: A 2.64 at 0.07 m, 2.28 at
-  // 0.15 m there), so that the reference at the result reproduces the recording's along spread.
-  const double ac = f.across.named ? f.across.value : 0, jt = f.jitter.named ? f.jitter.value : 0;
-  f.anchor_along = opt.along_at_fit && (ac > 0 || jt > 0) ? at(ac, 0, jt) : f.base;
-  std::vector<int> along_bands;
-  for (int b : bands)
-    if (usable(f.anchor_along.band[b], opt.min_matches)) along_bands.push_back(b);
-  auto fitAlong = [&] {
-    double an = 0, ad = 0;
-    for (int b : along_bands) {
-      const SpreadBand &r = f.real.band[b], &b0 = f.anchor_along.band[b];
-      const double wb = 1.0 / std::max(var(r.radial, r.radial_se, b0.radial, b0.radial_se), 1e-12);
-      an += wb * f.gain_along * (r.radial * r.radial - b0.radial * b0.radial);
-      ad += wb * f.gain_along * f.gain_along;
-    }
-    x3 = ad > 0 ? std::max(0.0, an / ad) : 0, s3 = ad > 0 ? std::sqrt(1.0 / ad) : 1.0;
-  };
-  fitAlong();
-  f.gain_along_probe = f.gain_along;
-  if (opt.along_at_fit && x3 > 0) {
-    const MatchedSpread m = at(ac, std::sqrt(x3), jt);
-    const double gain = (std::pow(m.all.radial, 2) - std::pow(f.anchor_along.all.radial, 2)) / x3;
-    if (gain > 0) f.gain_along = gain, fitAlong();
-  }
-  judge(f.along, x3, s3, 1.0, bin, dropOf(resAlong(x3), resAlong(0)));
   for (int b = 0; b < 4; ++b)
-    if (std::isfinite(f.base.band[b].tangential) && std::isfinite(f.anchor_along.band[b].radial)) {
+    if (std::isfinite(f.base.band[b].tangential)) {
       f.model_across[b] = across(b, x(0), x(1)), f.model0_across[b] = across(b, 0, 0);
-      f.model_along[b] = along(b, x3), f.model0_along[b] = f.base.band[b].radial;
+      f.model_along[b] = along(b, x3), f.model0_along[b] = along(b, 0);
     }
   const auto nm = f.named();
   f.after = nm.empty() ? f.base
@@ -231,11 +213,9 @@ std::string glintTermsTable(const GlintTermsFit& f) {
   auto row = [&](const std::string& name, const MatchedSpread& m) { writeSpreadTableRow(os, name, m); };
   row("recording", f.real);
   if (f.base.pairs) row("model, terms 0", f.base);
-  if (f.anchor_along.pairs && f.anchor_along.all.radial != f.base.all.radial)
-    row("model, named across terms (along anchor)", f.anchor_along);
   if (f.after.pairs && !f.named().empty()) row("model, named terms", f.after);
-  os << "\ngains: across " << f.gain_across << ", along " << f.gain_along << " (probe "
-     << f.gain_along_probe << "), jitter " << f.gain_jitter << " (spread^2 per term^2)\n";
+  os << "\ngains: across " << f.gain_across << ", along " << f.gain_along << ", jitter " << f.gain_jitter
+     << " (spread^2 per term^2, from the probe renders)\n";
   return os.str();
 }
 

@@ -115,11 +115,11 @@ TEST(GlintTermsFit, ConcealedAzimuthJitterFitted) {
 }
 
 // RADIATE's fitted terms concealed on its sensor model (0.174 m bins), on the reference's route
-// (other segment and seed) and on another: glint_along comes back within 10 % beside the jitter.
-// The reference rendered at the fitted terms shows 7-11 % more along spread than the recording
-// (its glint-free along spread is larger and does not subtract in quadrature): the same excess as
-// RADIATE's re-simulation. Option along_at_fit removes that excess on the reference's route, at the
-// cost of a lower along value (docs/diagnose_glint.md).
+// (another segment and seed than the reference's) and on another route: glint_along comes back
+// within 10 % beside the azimuth jitter and the across glint, which widen the along spread too.
+// (The reference rendered at the fit then shows 0.132-0.141 m along against the recordings'
+// 0.124-0.127 m: the along figure's segment-to-segment scatter at fixed terms, not a fit error;
+// docs/diagnose_glint.md.)
 TEST(GlintTermsFit, ConcealedAlongBesideJitterOnRadiateSensor) {
   sim::SensorConfig radiate = sim::SensorConfig::loadNamed("radiate");
   radiate.physics.clear();
@@ -127,22 +127,12 @@ TEST(GlintTermsFit, ConcealedAlongBesideJitterOnRadiateSensor) {
   sim::Simulator sim(std::move(sc.world), std::move(sc.trajectory), radiate, drive(0.06, 0.07, 0.3), 7);
   std::vector<PolarScan> city;
   for (int i = 100; i < 116; ++i) city.push_back(sim.renderScan(i));
-  for (const auto* rec : {&city}) {
-    const GlintTermsFit g = fitGlintTerms(*rec, radiate, drive());
+  for (const auto& rec : {city, recording(drive(0.06, 0.07, 0.3), 300, 16, radiate)}) {
+    const GlintTermsFit g = fitGlintTerms(rec, radiate, drive());
     std::cout << glintTermsTable(g);
     expectTerm(g.along, 0.07);
     expectTerm(g.jitter, 0.3);
-    EXPECT_GT(g.after.all.radial, 1.05 * g.real.all.radial);
-    GlintTermsOptions o;
-    o.along_at_fit = true;
-    const GlintTermsFit h = fitGlintTerms(*rec, radiate, drive(), o);
-    std::cout << glintTermsTable(h);
-    EXPECT_NEAR(h.after.all.radial, h.real.all.radial, 0.05 * h.real.all.radial);
-    EXPECT_LT(h.along.value, g.along.value);
   }
-  const GlintTermsFit o = fitGlintTerms(recording(drive(0.06, 0.07, 0.3), 300, 16, radiate), radiate, drive());
-  expectTerm(o.along, 0.07);
-  expectTerm(o.jitter, 0.3);
 }
 
 TEST(GlintTermsFit, NullNamesNothingOneScanNotIdentifiable) {

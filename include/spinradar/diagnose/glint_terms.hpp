@@ -41,11 +41,6 @@ struct GlintTermsOptions {
   double z_min = 4.0;
   double half_unit = 0.5;       ///< practical size: this share of a range bin / azimuth row
   double drop_min = 0.05;       ///< practical size: this relative residual drop
-  /// Along against a render with the named across terms and its gain taken at the first fit, so
-  /// that the reference rendered at the result matches the recording's along spread (off: against
-  /// the terms-0 render with the probe's gain: the physical value, within 10 % on known truth;
-  /// on, it comes out 7-20 % low on other scenes: docs/diagnose_glint.md).
-  bool along_at_fit = false;
 };
 
 struct GlintTerm {
@@ -61,9 +56,7 @@ struct GlintTerm {
 struct GlintTermsFit {
   bool measured = false;        ///< the recording has at least one pair of distinct scans
   MatchedSpread real, base, probe_glint, probe_jitter, after;
-  MatchedSpread anchor_along;              ///< the reference with the named across terms, along 0
-  double gain_across = 0, gain_along = 0;  ///< G, A (spread^2 per glint^2; A at the fitted along)
-  double gain_along_probe = 0;             ///< A from the probe render (first step)
+  double gain_across = 0, gain_along = 0;  ///< G, A (spread^2 per glint^2)
   double gain_jitter = 0;                  ///< J (spread^2 per (range * jitter in rad)^2)
   GlintTerm across, along, jitter;
   /// Model across / along per band at the fitted terms and without any (recording's ranges).
