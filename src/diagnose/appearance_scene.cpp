@@ -236,7 +236,10 @@ sim::World recordingWorld(const PolarScan& scan, const SensorConfig& s,
     pk.p = resid / K(delta);
     at_row[i] = delta;  // a later row i' sees it at (row(i) - row(i')) + delta rows
     const double step = 2.0 * M_PI / n;
-    const double range = scan.rangeOfBin(pk.b), phi = scan.azimuth[pk.r] + delta * step;
+    // On the rendered scan's row grid (row a at a * step), not at the recording's azimuth:
+    // MulRan's rows sit 9/14 of a row past it (encoder 14 a + 9), and its scene came out
+    // 0.64 rows late, every strong return split over two rows (docs/diagnose_scene.md).
+    const double range = scan.rangeOfBin(pk.b), phi = (pk.r + delta) * step;
     sim::Target t;
     t.x = range * std::cos(phi);  // sensor frame: azimuth clockwise from forward
     t.y = -range * std::sin(phi);

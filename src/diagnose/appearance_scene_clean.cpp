@@ -253,7 +253,7 @@ sim::World cleanWorld(const PolarScan& scan, const sim::SensorConfig& s,
   sim::World w;
   for (const Taken& k : taken) {
     const double range = scan.rangeOfBin(k.b + k.ib / 32.0);
-    const double phi = scan.azimuth[size_t(k.r)] + k.ir / 32.0 * step;
+    const double phi = (k.r + k.ir / 32.0) * step;  // the rendered row grid (appearance_scene.cpp)
     sim::Target t;
     t.x = range * std::cos(phi);  // sensor frame: azimuth clockwise from forward
     t.y = -range * std::sin(phi);

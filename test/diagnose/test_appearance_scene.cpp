@@ -46,6 +46,34 @@ TEST(AppearanceScene, KnownTargetComesBackWhereAndAsStrongAsItIs) {
   }
 }
 
+// MulRan labels row a with encoder 14 a + 9 (of 5600): its azimuths sit 9/14 of a row past the
+// rendered row grid. The scene must come back on the rows it was recorded in, not 0.64 rows late
+// (before the fix the target's re-render peaked one row on, 2-5 dB down, split over two rows).
+TEST(AppearanceScene, RecordedRowsNotTheirAzimuthLabelsPlaceTheScene) {
+  const sim::SensorConfig s = baseSensor();
+  for (const double row : {100.0, 100.3}) {  // on a row, and between rows
+    const double phi = row * 2 * M_PI / s.azimuths, r = 40.0;
+    PolarScan scan = oneTarget(s, r * std::cos(phi), -r * std::sin(phi), 10.0);
+    for (double& a : scan.azimuth) a += 9.0 / 14.0 * 2 * M_PI / s.azimuths;  // MulRan labels
+    const sim::World w = recordingWorld(scan, s, AppearanceOptions{});
+    const sim::Trajectory standing({{0.0, {}}, {2.0, {}}});
+    const PolarScan again = sim::Simulator(w, standing, s, {}, 9).renderScan(0);
+    const int b = int(std::lround(scan.binOfRange(r)));
+    auto peakRow = [&](const PolarScan& sc, int& level) {
+      int best = -1;
+      level = -1;
+      for (int a = 90; a < 110; ++a)
+        for (int bb = b - 3; bb <= b + 3; ++bb)
+          if (sc.row(a)[bb] > level) level = sc.row(a)[bb], best = a;
+      return best;
+    };
+    int lr = 0, ls = 0;
+    const int ar = peakRow(scan, lr), as = peakRow(again, ls);
+    EXPECT_EQ(as, ar) << row;
+    EXPECT_NEAR(ls, lr, 1.5 * s.power_scale) << row;  // the quantiser's step and the row grid
+  }
+}
+
 TEST(AppearanceScene, HeldOutRowsAreNeverRead) {
   const sim::SensorConfig s = baseSensor();
   const PolarScan scan = oneTarget(s, 30.0, -12.0, 10.0);
