@@ -41,7 +41,7 @@ void locateAppearance(AppearanceReport& rep) {
     add(rep, "range band, mid intensities", kBandNames[k], r.mean[k], s.mean[k], "dB", 1.0,
         "mean count");
     add(rep, "range band, high intensities", kBandNames[k], r.bright[k], s.bright[k], "dB", 1.0,
-        "mean of the brightest 1 %");
+        "mean of the brightest 5 %");
     add(rep, "range band, texture", kBandNames[k], std::pow(10.0, r.cfar[k]) - 1,
         std::pow(10.0, s.cfar[k]) - 1, "CA-CFAR cells/scan",
         0.15 * std::max(1.0, std::pow(10.0, r.cfar[k])), "clutter standing out of its neighbourhood");
@@ -330,7 +330,7 @@ void writeAppearanceReport(const AppearanceReport& rep, const std::vector<PolarS
                        .line(bx, ca, "sim, fitted model")
                        .render(700, 450));
   panels.push_back(Plot()
-                       .title("brightest 1 % by range band (range gain)")
+                       .title("brightest 5 % by range band (range gain)")
                        .xlabel("band centre (m)")
                        .ylabel("mean count")
                        .line(bx, fr, "recording")
