@@ -139,5 +139,35 @@ TEST(AppearanceScene, SensorRecoveredOnAnotherSceneWithItsOwnScene) {
   }
 }
 
+// Known truth with MulRan's row labels (9/14 of a row past the render's grid, as the sample's
+// encoder 14 a + 9): a noise floor 3 dB up comes back within 1 dB and alone; the null names nothing.
+// (Noise is the same on every row, so this held before the row-grid fix too; the test above is
+// the one the fix is needed for.)
+TEST(AppearanceScene, ConcealedNoiseRecoveredWithMulranRowLabels) {
+  AppearanceOptions rec_opt = testing::catalogueOnlyOptions();
+  rec_opt.scene = "out_and_back";
+  for (const bool noise : {true, false}) {
+    sim::SensorConfig truth = baseSensor();
+    if (noise) truth.noise_floor_db += 3;
+    auto rec = renderReference(truth, {}, rec_opt, 4242);
+    for (PolarScan& sc : rec)
+      for (double& a : sc.azimuth) a += 9.0 / 14.0 * 2 * M_PI / sc.azimuths;
+    AppearanceOptions opt = testing::catalogueOnlyOptions();
+    opt.scene = "recording";
+    const AppearanceReport rep = diagnoseAppearance(rec, baseSensor(), {}, opt);
+    const std::string named = testing::namedFindings(rep);
+    if (std::getenv("SPINRADAR_TEST_VERBOSE"))
+      std::cerr << "noise " << noise << ": named '" << named << "' fitted "
+                << rep.fitted.noise_floor_db << " truth " << truth.noise_floor_db << "\n";
+    if (noise) {
+      EXPECT_NEAR(rep.fitted.noise_floor_db, truth.noise_floor_db, 1.0) << named;
+      EXPECT_EQ(named.find("noise_floor_db"), 0u) << named;
+      EXPECT_EQ(named.find(' ', 0), named.size() - 1) << "more than one named: " << named;
+    } else {
+      EXPECT_TRUE(named.empty()) << named;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace spinradar::diagnose
