@@ -10,12 +10,16 @@
 // gives a third estimate with one. Their information-weighted mean (left perturbation on SE(2))
 // damps the walk: the heading after each switch is a weighted mean of two paths.
 //
-// The extra registration reuses the scan's own (descriptor matches and solve, the proximity
-// ICP where the keyframe is turned, the re-association at kReassociateGate) with the earlier
-// keyframe swapped in. It is solved with the chained pose as a weak prior
-// (kFusionPriorInflation x its covariance) and its covariance leaves the prior out (cov_acc,
-// with the keyframe map's own error and the row quantization as in track()). An estimate far
-// from the chained one (kFusionChi2) or a failed registration is not fused.
+// The extra registration reuses the scan's own (descriptor matches and solve at kMinInliers,
+// the re-association at kReassociateGate) with the earlier keyframe swapped in. It is solved
+// with the chained pose as a weak prior (kFusionPriorInflation x its covariance) and its
+// covariance leaves the prior out (cov_acc, with the keyframe map's own error and the row
+// quantization as in track()). An estimate far from the chained one (kFusionChi2) or a failed
+// registration is not fused.
+// Measured (tenth round): synthetic drive under 0.14 m glint, summed heading rms 0.271 ->
+// 0.219 deg; on the simulated sensor columns the direct registration rarely reaches
+// kMinInliers (city_oxford layouts 0-2: never) and is worse than the chain where it does on
+// the narrow-PSF columns: an option, off by default.
 #include <algorithm>
 #include <cmath>
 
