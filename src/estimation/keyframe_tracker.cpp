@@ -19,6 +19,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   const double dt = has_last_stamp_ ? 1e-9 * static_cast<double>(cur.stamp_ns - last_stamp_) : 0.25;
   last_stamp_ = cur.stamp_ns;
   has_last_stamp_ = true;
+  nndr_ = nndr;
   const double c = kMidScan * scan_period_.update(cur, dt);  // mid-scan, see ScanPeriod
   // A dropped scan (or a recording read every other scan): the step is a gap (scan_period.hpp).
   const bool gap_step = has_key_ && ScanPeriod::isGap(dt, ScanPeriod::rotation(cur));
@@ -93,6 +94,9 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     const Eigen::Vector3d q2(kStepAccelSigma, kStepAccelSigma, kStepAngAccelSigma);
     Cxi_acc_ = pair.velocity_cov;
     Cxi_acc_.diagonal() += (accel_.cwiseAbs2() + q2.cwiseAbs2()) * std::pow(kHonestLag * dt, 2);
+    fuse_xi_prior_ = xi_prior;  // for the extra registrations (keyframe_fusion.cpp)
+    fuse_Cxi_ = Cxi;
+    fuse_Cxi_honest_ = Cxi_honest;
     Eigen::Vector3d xi = xi_prior;
     Eigen::Matrix<double, 6, 6> cov;
     Eigen::Matrix3d T = T_odo;
@@ -312,6 +316,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   // twice, and kept: an over-statement that hid part of the over-confidence in turns. So the
   // chain runs over the keyframes' mid-scan poses M_j = T_wj E_j (P_jm_), with cov_acc.
   Eigen::Matrix3d P_m_next;  // M_k's, should this scan become the keyframe
+  Eigen::Matrix3d C_jk_acc, Cxi_k_acc;  // T_jk's [x, y, yaw] and xi_k's (keyframe_fusion)
   {
     const Eigen::Matrix<double, 6, 6> Cd = withModelErrors(cov_acc);
     const Eigen::Matrix3d M_j = T_wj_ * E_j;
@@ -328,7 +333,8 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     const Eigen::Matrix3d C_mk = Lk * (J * Cd * J.transpose() + Ckey) * Lk.transpose();
     Eigen::Matrix3d T_unused;
     se2::compoundXyYaw(M_j, P_jm_, T_mk, C_mk, T_unused, P);
-    const Eigen::Matrix3d C_jk_acc = Lm * (Cd.topLeftCorner<3, 3>() + Ckey) * Lm.transpose();
+    C_jk_acc = Lm * (Cd.topLeftCorner<3, 3>() + Ckey) * Lm.transpose();
+    Cxi_k_acc = Cd.bottomRightCorner<3, 3>();
     se2::compoundXyYaw(M_j, P_jm_, T_jk, C_jk_acc, T_unused, P_m_next);
   }
   pair.T_12 = se2::inverse(T_w_prev) * T_w;
@@ -344,6 +350,18 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   prev_pair_xi_ = pair.velocity;
   prev_xi_ = xi_k;
   if (renew) {
+    // EstimatorConfig::keyframe_fusion: register the new keyframe against the earlier ones
+    // too and fuse (keyframe_fusion.cpp); its published pose and covariance follow.
+    Eigen::Matrix3d M_k = T_wj_ * E_j * T_jk;
+    if (config_.keyframe_fusion > 0 && !still && fuseWithPast(cur, c, T_jk, C_jk_acc, M_k, P_m_next)) {
+      const Eigen::Matrix3d E_k = se2::exp(-c * xi_k);
+      const Eigen::Matrix3d Le = se2::leftPerturbationToXyYaw(E_k);
+      const Eigen::Matrix3d C_e = Le * (c * c * Cxi_k_acc) * Le.transpose();
+      se2::compoundXyYaw(M_k, P_m_next, E_k, C_e, T_w, P);
+      pair.T_12 = se2::inverse(T_w_prev) * T_w;
+    }
+    pushPastKeyframe();
+    key_rel_cov_ = C_jk_acc;
     key_xi_cov_ = xi_cov_pub;
     key_xi_cov_(2, 2) += dw2 / 3.0;  // as above: the keyframe map was moved with that yaw rate
     makeKeyframe(cur, xi_key, c, T_w, P);

@@ -73,6 +73,7 @@ class KeyframeTracker {
   void reset() {
     has_key_ = has_last_stamp_ = false;
     submap_count_ = submap_next_ = 0;
+    past_count_ = 0;
   }
 
   /// cur: the newest scan (raw keypoints and descriptors). pair: the frame-to-frame estimate
@@ -111,6 +112,10 @@ class KeyframeTracker {
   const Eigen::Matrix3d& relativePose() const { return rel_T_; }
   const Eigen::Matrix3d& relativeCov() const { return rel_C_; }
   int keyframeSwitches() const { return switches_; }
+  /// EstimatorConfig::keyframe_fusion: extra registrations of new keyframes against earlier
+  /// ones that were fused, and that were refused (chi-square gate) or failed.
+  int fusionsAccepted() const { return fusions_accepted_; }
+  int fusionsRejected() const { return fusions_rejected_; }
 
   static constexpr double kKeyframeDistance = 10.0;  ///< m, new keyframe beyond this
   static constexpr double kKeyframeAngle = 0.35;     ///< rad
@@ -182,6 +187,14 @@ class KeyframeTracker {
   /// nearest point within this gate of each earlier keyframe of the submap (keyframe_map.cpp):
   /// 2.5 sigma of the difference of two returns under the simulator's 0.14 m glint.
   static constexpr double kSubmapGate = 0.5;
+  /// EstimatorConfig::keyframe_fusion (keyframe_fusion.cpp): the extra registration against
+  /// an earlier keyframe is solved with the chained pose as a prior of this many times its
+  /// covariance (a weak pull: it only holds directions the registration leaves open; its
+  /// covariance leaves the prior out, as every registration's), and refused when its squared
+  /// Mahalanobis distance from the chained pose (over the left perturbation, both
+  /// covariances) exceeds kFusionChi2 (chi-square, 3 degrees of freedom, 99 %).
+  static constexpr double kFusionPriorInflation = 16.0;
+  static constexpr double kFusionChi2 = 11.34;
 
  private:
   ScanPeriod scan_period_;  ///< the rotation period, for the mid-scan reference (gaps)
@@ -270,6 +283,47 @@ class KeyframeTracker {
   /// nearest point within kSubmapGate in each earlier keyframe of the ring, then puts the raw
   /// points into the ring. Nothing with submap_keyframes 1.
   void averageWithSubmap(const Eigen::Matrix3d& M_w);
+  /// EstimatorConfig::keyframe_fusion (issue 19): the keyframes before the current one, most
+  /// recent first (past_[0] is the one before the current keyframe), with what is needed to
+  /// register a scan against them again.
+  struct PastKeyframe {
+    std::vector<Eigen::Vector2d> pts;
+    std::vector<double> tau;
+    std::vector<std::pair<double, int>> by_x;
+    cv::Mat desc_storage, desc;
+    Eigen::Matrix3d M_w = Eigen::Matrix3d::Identity();  ///< mid-scan world pose
+    Eigen::Matrix3d P_m = Eigen::Matrix3d::Zero();      ///< its covariance (P_jm_)
+    /// [x, y, yaw] covariance of its mid-scan pose relative to the keyframe before it.
+    Eigen::Matrix3d C_rel = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d xi_cov = Eigen::Matrix3d::Zero();  ///< key_xi_cov_
+    Eigen::Vector3d accel = Eigen::Vector3d::Zero();   ///< key_accel_
+    double c = 0.0;                                    ///< key_c_
+    int64_t stamp = 0;                                 ///< key_stamp_
+  };
+  std::vector<PastKeyframe> past_;
+  size_t past_count_ = 0;
+  /// [x, y, yaw] covariance of the current keyframe's mid-scan pose relative to the keyframe
+  /// before it (the registration that made it, cov_acc with its model errors).
+  Eigen::Matrix3d key_rel_cov_ = Eigen::Matrix3d::Zero();
+  int fusions_accepted_ = 0, fusions_rejected_ = 0;
+  double nndr_ = 0.8;  ///< track()'s ratio test, for the extra registrations
+  /// The current scan's velocity prior and its covariances (track()), for the extra ones.
+  Eigen::Vector3d fuse_xi_prior_ = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d fuse_Cxi_ = Eigen::Matrix3d::Identity(), fuse_Cxi_honest_ = Eigen::Matrix3d::Identity();
+  /// Moves the current keyframe into past_ (before makeKeyframe replaces it).
+  void pushPastKeyframe();
+  /// cur becomes the keyframe: registers it against past_ (the chained estimate M_jk: its
+  /// mid-scan pose relative to the current keyframe's, C_jk its [x, y, yaw] covariance) and
+  /// fuses. M_k (mid-scan world pose) and P_m (its covariance) in/out. True when fused.
+  bool fuseWithPast(const FeatureFrame& cur, double c, const Eigen::Matrix3d& T_jk,
+                    const Eigen::Matrix3d& C_jk, Eigen::Matrix3d& M_k, Eigen::Matrix3d& P_m);
+  /// Registers cur against pk (swapped in as the keyframe) from the prediction T_pred (cur's
+  /// mid-scan pose relative to pk's) with covariance C_pred: T (relative) and C ([x, y, yaw],
+  /// the prior left out). False when the registration fails.
+  bool registerToPast(const FeatureFrame& cur, PastKeyframe& pk, double c,
+                      const Eigen::Matrix3d& T_pred, const Eigen::Matrix3d& C_pred,
+                      Eigen::Matrix3d& T, Eigen::Matrix3d& C);
+  void swapKeyframe(PastKeyframe& pk);
 };
 
 }  // namespace spinradar
