@@ -9,7 +9,6 @@
 
 #include "spinradar/core/feature_frame.hpp"
 #include "spinradar/core/stage_times.hpp"
-#include "spinradar/estimation/rigid_ransac.hpp"
 #include "spinradar/features/feature_extractor.hpp"
 #include "spinradar/features/matcher.hpp"
 
@@ -39,7 +38,7 @@ int64_t cellKey(long cx, long cy) { return (static_cast<int64_t>(cx) << 32) ^ (c
 
 struct RepeatabilityMeter::Impl {
   Impl(const PipelineConfig& c, sim::Trajectory t, RepeatabilityOptions o)
-      : config(c), truth(std::move(t)), opt(std::move(o)), extractor(c.detector, c.features), ransac(c.estimator) {
+      : config(c), truth(std::move(t)), opt(std::move(o)), extractor(c.detector, c.features) {
     opt.validate();
     const size_t nb = opt.band_edges.size() + 1;
     sum.band_keypoints.assign(nb, 0.0);
@@ -68,7 +67,6 @@ struct RepeatabilityMeter::Impl {
   sim::Trajectory truth;
   RepeatabilityOptions opt;
   FeatureExtractor extractor;
-  RigidRansac ransac;
   std::deque<Frame> history;
   std::vector<Match> matches;
   Repeatability sum;
@@ -103,22 +101,19 @@ void RepeatabilityMeter::add(const PolarScan& scan) {
     // As the keyframe tracker matches: the older scan's descriptors against the newer's.
     matchDescriptors(key.f.descriptors, cur.f.descriptors, m.config.features.nndr, m.matches);
     out.matches += static_cast<double>(m.matches.size());
+    int confirmed = 0;
     for (const Match& x : m.matches)
       if (std::hypot(cur.wx[x.i2] - key.wx[x.i1], cur.wy[x.i2] - key.wy[x.i1]) < m.opt.truth_radius) {
-        out.true_matches += 1.0;
+        ++confirmed;
         out.band_true[m.band(cur.f.keypoints[x.i2].range)] += 1.0;
       }
+    out.true_matches += confirmed;
     for (size_t i = 0; i < cur.f.keypoints.size(); ++i)
       if (m.near(key, cur.wx[i], cur.wy[i]) >= 0) {
         out.repeatable += 1.0;
         out.band_repeatable[m.band(cur.f.keypoints[i].range)] += 1.0;
       }
-    MotionEstimate est;
-    const int inl = m.ransac.estimate(key.f.keypoints, cur.f.keypoints, m.matches, key.f.stamp_ns, cur.f.stamp_ns, est)
-                        ? static_cast<int>(est.inliers.size())
-                        : 0;
-    out.inliers += inl;
-    if (inl < m.opt.weak_inliers) ++m.weak[g - 1];
+    if (confirmed < m.opt.weak_inliers) ++m.weak[g - 1];
     ++out.pairs;
   }
   m.history.push_back(std::move(cur));
@@ -135,7 +130,7 @@ Repeatability RepeatabilityMeter::result() const {
   for (size_t g = 0; g < r.gaps.size(); ++g) {
     GapFigures& x = r.gaps[g];
     const double p = std::max(1, x.pairs);
-    x.repeatable /= p, x.matches /= p, x.true_matches /= p, x.inliers /= p;
+    x.repeatable /= p, x.matches /= p, x.true_matches /= p;
     x.weak_share = x.pairs ? m.weak[g] / p : 0.0;
     for (double& v : x.band_repeatable) v /= p;
     for (double& v : x.band_true) v /= p;
@@ -149,12 +144,12 @@ std::string repeatabilityTable(const Repeatability& r, const RepeatabilityOption
   std::snprintf(buf, sizeof buf, "%d scans, %.0f keypoints per scan, feature stage %.2f ms per scan\n\n", r.scans,
                 r.keypoints, r.feature_ms);
   s += buf;
-  s += "| gap | repeatable | matches | true | RANSAC inliers | weak (< " + std::to_string(o.weak_inliers) +
-       ") | true by band |\n|---|---|---|---|---|---|---|\n";
+  s += "| gap | repeatable | matches | true | weak (< " + std::to_string(o.weak_inliers) +
+       " true) | true by band |\n|---|---|---|---|---|---|\n";
   for (size_t g = 0; g < r.gaps.size(); ++g) {
     const GapFigures& x = r.gaps[g];
-    std::snprintf(buf, sizeof buf, "| %zu | %.0f | %.0f | %.0f | %.0f | %.0f %% |", g + 1, x.repeatable, x.matches,
-                  x.true_matches, x.inliers, 100.0 * x.weak_share);
+    std::snprintf(buf, sizeof buf, "| %zu | %.0f | %.0f | %.0f | %.0f %% |", g + 1, x.repeatable, x.matches,
+                  x.true_matches, 100.0 * x.weak_share);
     s += buf;
     for (double v : x.band_true) std::snprintf(buf, sizeof buf, " %.1f", v), s += buf;
     s += " |\n";
