@@ -36,10 +36,19 @@ void run(const FeaturesArgs& a) {
   }
   const ScanFolder folder(a.input, ScanFormat::Auto, opts);
   if (folder.empty()) throw std::runtime_error(folder.folder() + ": no scans found");
-  diagnose::RepeatabilityMeter meter(cfg, sim::Trajectory::loadCsv(truth), a.options);
+  const sim::Trajectory trajectory = sim::Trajectory::loadCsv(truth);
+  diagnose::RepeatabilityMeter meter(cfg, trajectory, a.options);
   PolarScan scan;
   for (size_t i = 0; i < folder.size() && static_cast<int>(i) < a.scans; ++i) {
     folder.load(i, scan);
+    // The truth must cover the scan (Trajectory::at clamps: a scan outside it would count no
+    // true match, silently). A tolerance of one scan period at either end.
+    const double t0 = 1e-9 * static_cast<double>(scan.firstStamp()), t1 = 1e-9 * static_cast<double>(scan.lastStamp());
+    if (t0 < trajectory.startTime() - 0.25 || t1 > trajectory.endTime() + 0.25)
+      throw std::runtime_error(truth + ": covers " + std::to_string(trajectory.startTime()) + " .. " +
+                               std::to_string(trajectory.endTime()) + " s, not scan " + std::to_string(i) + " (" +
+                               folder.path(i) + ", " + std::to_string(t0) + " .. " + std::to_string(t1) +
+                               " s): not this recording's truth, or a clock offset");
     meter.add(scan);
   }
   std::cout << a.input << ": " << diagnose::repeatabilityTable(meter.result(), a.options);
