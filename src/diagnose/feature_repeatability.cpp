@@ -156,7 +156,7 @@ std::string repeatabilityTable(const Repeatability& r, const RepeatabilityOption
   }
   s += "\nrange bands (m):";
   for (size_t b = 0; b <= o.band_edges.size(); ++b) {
-    std::snprintf(buf, sizeof buf, b == 0 ? " < %.0f" : b < o.band_edges.size() ? ", %.0f-%.0f" : ", > %.0f",
+    std::snprintf(buf, sizeof buf, b == 0 ? " < %g" : b < o.band_edges.size() ? ", %g-%g" : ", > %g",
                   b == 0 ? o.band_edges[0] : o.band_edges[b - 1], b < o.band_edges.size() ? o.band_edges[b] : 0.0);
     s += buf;
   }

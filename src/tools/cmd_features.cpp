@@ -72,6 +72,9 @@ SPINRADAR_COMMAND("features",
                                    "Two keypoints are one return when the truth puts them this close (m)")
                         ->capture_default_str()
                         ->check(CLI::Range(0.01, 10.0));
+                    app.add_option("--band-edges", a->options.band_edges,
+                                   "Range band edges (m), increasing; the last band is beyond the last edge")
+                        ->delimiter(',');
                     a->pipeline.add(app);
                     app.callback([a] { a->options.validate(); run(*a); });
                   });
