@@ -167,7 +167,20 @@ sim::World recordingWorld(const PolarScan& scan, const SensorConfig& s,
   // Along azimuth every row keeps its own: an extended object (a wall, a car) spans rows, and
   // one scatterer per blob would render it narrower, a spurious wide beam in the fit.
   const int wb = std::max(1, int(std::ceil(2 * s.range_psf_sigma_bins)));
-  const double margin = opt.scene_margin_db * per_db;
+  // Margin per bin: scene_margin_db, or the band's own (scene_margin_bands_db: 2.5-10, 10-25,
+  // 25-50, 50 m and on).
+  const std::vector<double>& mb = opt.scene_margin_bands_db;
+  if (!mb.empty() && mb.size() != 4)
+    throw std::invalid_argument("appearance recording scene: scene_margin_bands_db needs 4 values");
+  for (const double m : mb)
+    if (!(m > 0 && m < 60))
+      throw std::invalid_argument("appearance recording scene: each band margin must be in (0, 60) dB");
+  std::vector<double> margin_at(size_t(nb), opt.scene_margin_db * per_db);
+  if (!mb.empty())
+    for (int b = 0; b < nb; ++b) {
+      const double r = scan.rangeOfBin(b);
+      margin_at[size_t(b)] = per_db * mb[r < 10 ? 0 : r < 25 ? 1 : r < 50 ? 2 : 3];
+    }
   const int b0 = std::max(0, int(std::ceil(scan.binOfRange(2.5))));
   struct Peak {
     int r, b;
@@ -179,7 +192,7 @@ sim::World recordingWorld(const PolarScan& scan, const SensorConfig& s,
     if (src[r] < 0) continue;
     for (int b = b0; b < nb; ++b) {
       const int c = at(r, b);
-      if (c < floor_q[b] + margin) continue;
+      if (c < floor_q[b] + margin_at[size_t(b)]) continue;
       bool peak = true;
       for (int bb = std::max(0, b - wb); bb <= std::min(nb - 1, b + wb) && peak; ++bb)
         // Ties go to the nearer bin, so a flat top gives one return.
@@ -211,8 +224,7 @@ sim::World recordingWorld(const PolarScan& scan, const SensorConfig& s,
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t x, size_t y) { return peaks[x].obs > peaks[y].obs; });
   std::vector<double> at_row(peaks.size(), 0.0);  // sub-row position of the taken ones
-  std::vector<int32_t> taken;
-  sim::World w;
+  std::vector<SceneScatterer> placed;
   for (const size_t i : order) {
     Peak& pk = peaks[i];
     double blur = 0;
@@ -235,15 +247,39 @@ sim::World recordingWorld(const PolarScan& scan, const SensorConfig& s,
     }
     pk.p = resid / K(delta);
     at_row[i] = delta;  // a later row i' sees it at (row(i) - row(i')) + delta rows
+    placed.push_back({pk.r, pk.b, delta, pk.p, 0.0});
+    if (opt.scene_range_subbin) {
+      // The middle of the peak's flat top (ties went to its first bin), then a parabola through
+      // the log powers of the top and the bins either side of it.
+      const int c0 = at(pk.r, pk.b);
+      int b1 = pk.b, b2 = pk.b;
+      while (b1 > 0 && pk.b - b1 < wb && at(pk.r, b1 - 1) == c0) --b1;
+      while (b2 + 1 < nb && b2 - pk.b < wb && at(pk.r, b2 + 1) == c0) ++b2;
+      double off = 0.5 * (b1 + b2) - pk.b;
+      if (b1 > 0 && b2 + 1 < nb) {
+        const double l = countToDb(at(pk.r, b1 - 1), s), c = countToDb(c0, s),
+                     h = countToDb(at(pk.r, b2 + 1), s), den = l - 2 * c + h;
+        if (den < 0) off += std::clamp(0.5 * (l - h) / den, -0.5, 0.5);
+      }
+      placed.back().bin_offset = off;
+    }
+  }
+  // Optionally the strengths fitted together, positions held (appearance_scene_refine.cpp).
+  refineAlongAzimuth(scan, s, src, floor_q, kern, placed, opt.scene_refine_passes);
+  sim::World w;
+  for (const SceneScatterer& t0 : placed) {
+    if (!(t0.p > 0)) continue;
     const double step = 2.0 * M_PI / n;
     // On the rendered scan's row grid (row a at a * step), not at the recording's azimuth:
     // MulRan's rows sit 9/14 of a row past it (encoder 14 a + 9), and its scene came out
     // 0.64 rows late, every strong return split over two rows (docs/diagnose_scene.md).
-    const double range = scan.rangeOfBin(pk.b), phi = (pk.r + delta) * step;
+    const double range = scan.rangeOfBin(t0.b + t0.bin_offset), phi = (t0.r + t0.delta) * step;
     sim::Target t;
     t.x = range * std::cos(phi);  // sensor frame: azimuth clockwise from forward
     t.y = -range * std::sin(phi);
-    t.rcs = 10.0 * std::log10(pk.p) - pointGainDb(range, s);
+    // Off a bin's centre the recorded peak is the range spread's value there, not its top.
+    const double top = t0.bin_offset != 0 ? std::max(rangePsf(s, t0.bin_offset), 0.25) : 1.0;
+    t.rcs = 10.0 * std::log10(t0.p / top) - pointGainDb(range, s);
     w.targets.push_back(t);
   }
   if (std::getenv("SPINRADAR_APPEARANCE_VERBOSE"))

@@ -27,6 +27,20 @@ double beamAt(const std::vector<double>& kern, double x);
 /// model's mainlobe and window sidelobes, render_model.cpp).
 double rangePsf(const sim::SensorConfig& s, double x);
 
+/// A scatterer of the one-point scene: row, bin, sub-row offset and power over the gain chain.
+struct SceneScatterer {
+  int r = 0, b = 0;
+  double delta = 0, p = 0;
+  double bin_offset = 0;  ///< sub-bin range offset (scene_range_subbin), bins
+};
+/// Strengths of the one-point scene refined jointly along azimuth, positions held
+/// (appearance_scene_refine.cpp): `passes` multiplicative NNLS updates of the model's azimuth
+/// response `kern` against the recording's power over `floor_q` on the rows `src` gives.
+void refineAlongAzimuth(const PolarScan& scan, const sim::SensorConfig& s,
+                        const std::vector<int>& src, const std::vector<int>& floor_q,
+                        const std::vector<double>& kern, std::vector<SceneScatterer>& sc,
+                        int passes);
+
 /// The CLEAN scene of one scan: `src` from sourceRows, `floor_q` the count of each bin's upper
 /// quartile, `per_db` the counts per dB of the margin.
 sim::World cleanWorld(const PolarScan& scan, const sim::SensorConfig& s,

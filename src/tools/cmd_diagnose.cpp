@@ -42,6 +42,9 @@ struct DiagnoseArgs {
   std::string appearance_scene = "city";
   std::string gain_chain;  // scene "combined": held gain chain from this sensor (file or name)
   double scene_margin_db = 10.0;
+  std::vector<double> scene_margins;  // per band: 2.5-10, 10-25, 25-50, 50 m and on
+  int scene_refine = 0;
+  bool scene_subbin = false;
   bool scene_clean = false;  // own scene by CLEAN instead of one scatterer per local maximum
   bool fit_spread = false;
 };
@@ -68,6 +71,9 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   opt.scene = a.appearance_scene;
   opt.scene_margin_db = a.scene_margin_db;
   opt.scene_clean = a.scene_clean;
+  opt.scene_margin_bands_db = a.scene_margins;
+  opt.scene_refine_passes = a.scene_refine;
+  opt.scene_range_subbin = a.scene_subbin;
   opt.fit_spread_bands = a.fit_spread;
   if (!a.gain_chain.empty()) {
     if (opt.scene != "combined")
@@ -325,6 +331,21 @@ SPINRADAR_COMMAND(
                      "range bin's upper quartile")
           ->check(CLI::Range(0.5, 59.0))
           ->capture_default_str();
+      app.add_option("--appearance-scene-margins", a->scene_margins,
+                     "With the recording's own scene: the margin per range band (dB; 2.5-10, "
+                     "10-25, 25-50, 50 m and on), in place of --appearance-scene-margin")
+          ->expected(4)
+          ->delimiter(',')
+          ->check(CLI::Range(0.5, 59.0));
+      app.add_option("--appearance-scene-refine", a->scene_refine,
+                     "With the recording's own scene: passes of the joint refinement of the "
+                     "scatterers' strengths along azimuth (0: off; docs/diagnose_scene.md)")
+          ->check(CLI::Range(0, 1000))
+          ->capture_default_str();
+      app.add_flag("--appearance-scene-subbin", a->scene_subbin,
+                   "With the recording's own scene: place each return between range bins "
+                   "(parabola through its bin's and its neighbours' log powers) instead of at "
+                   "its bin's centre (docs/diagnose_scene.md, tenth round)");
       app.add_flag("--appearance-scene-clean", a->scene_clean,
                    "With the recording's own scene: build it by CLEAN deconvolution (extended "
                    "returns become several scatterers and keep their width) instead of one "

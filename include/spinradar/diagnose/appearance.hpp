@@ -82,6 +82,23 @@ struct AppearanceOptions {
   /// "recording" scene: a return is a local maximum this far above its range bin's upper quartile
   /// (over the upper quartile; exponential speckle exceeds that in 1e-6 of the cells).
   double scene_margin_db = 10.0;
+  /// "recording" scene: a margin per range band (dB; 2.5-10, 10-25, 25-50, 50 m and on), in place
+  /// of scene_margin_db where given (empty: scene_margin_db everywhere). Weak returns at far
+  /// range lie under a 10 dB margin (MulRan 50-100 m: the re-simulation misses 85 % of the
+  /// recording's CA-CFAR runs peaking under 20 counts; docs/diagnose_scene.md, tenth round).
+  std::vector<double> scene_margin_bands_db;
+  /// "recording" scene (one scatterer per local maximum): passes of a joint refinement of the
+  /// scatterers' strengths along azimuth, positions held (multiplicative non-negative least
+  /// squares of the model's rendered blur against the recording's power over the floor, rows
+  /// +-the beam's span of each scatterer's bin). 0: each row rebuilt on the blur of the ones
+  /// taken before it only, so the later, weaker rows' blur came on top of the strong rows and
+  /// the strong returns rendered wider than recorded (MulRan -27 dB at +-2 rows against -33).
+  int scene_refine_passes = 0;
+  /// "recording" scene (one scatterer per local maximum): place each return between range bins
+  /// (the vertex of a parabola through the log powers of its bin and the two neighbours, exact
+  /// for the model's Gaussian range spread) instead of at its bin's centre. Off: every return
+  /// re-rendered centred on a bin, so its rendered shape is not the recorded one.
+  bool scene_range_subbin = false;
   /// "recording" scene built by deconvolution (CLEAN, appearance_scene_clean.cpp): the strongest
   /// remaining return becomes a scatterer and the model's point response (range spread x beam)
   /// is taken off, until the residual is under the margin, so an extended return (a wall, a
