@@ -61,9 +61,8 @@ void splitSurvey(const std::vector<PolarScan>& scans, const std::string& dir) {
     c.push_back(diagnose::parseHoldoutSplit(n));
   const std::string md = diagnose::splitSurveyMarkdown(diagnose::surveySplits(scans, c));
   fs::create_directories(dir);
-  std::ofstream f(fs::path(dir) / "split_survey.md");
-  f << md;
-  if (!f) throw std::runtime_error(dir + "/split_survey.md: cannot write");
+  if (!(std::ofstream(fs::path(dir) / "split_survey.md") << md))
+    throw std::runtime_error(dir + "/split_survey.md: cannot write");
   std::cout << md;
 }
 
@@ -336,16 +335,9 @@ SPINRADAR_COMMAND(
                      "rows, N even, alternate fit / held out in every scan), scans (every other "
                      "scan) or contiguous (first half of the scans, or quarters 0+2 of one scan; "
                      "the ninth round's); default by the rule in docs/diagnose_holdout.md")
-          ->check(CLI::Validator(
-              [](std::string& v) -> std::string {
-                try {
-                  diagnose::parseHoldoutSplit(v);
-                  return {};
-                } catch (const std::invalid_argument& e) {
-                  return e.what();
-                }
-              },
-              "", "SPLIT"))
+          ->check(CLI::Validator([](std::string& v) -> std::string {
+            try { return diagnose::parseHoldoutSplit(v), std::string(); } catch (const std::invalid_argument& e) { return e.what(); }
+          }, "", "SPLIT"))
           ->capture_default_str();
       app.add_flag("--appearance-split-survey", a->split_survey,
                    "Only measure the real halves' own difference under candidate splits (the "
