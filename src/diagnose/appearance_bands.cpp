@@ -157,32 +157,6 @@ sim::RealismStats realismOf(const SensorConfig& s, const sim::PhysicsConfig& phy
   return sim::computeRealism(renderReference(s, physics, opt, seed), name, sim::RealismOptions{});
 }
 
-void splitHoldout(const std::vector<PolarScan>& scans, std::vector<PolarScan>& fit,
-                  std::vector<PolarScan>& holdout) {
-  fit.clear();
-  holdout.clear();
-  if (scans.size() >= 2) {
-    const size_t n_fit = (scans.size() + 1) / 2;
-    fit.assign(scans.begin(), scans.begin() + n_fit);
-    holdout.assign(scans.begin() + n_fit, scans.end());
-    return;
-  }
-  for (const PolarScan& s : scans) {
-    // One scan: quarters 0 and 2 to fit, 1 and 3 held out (different parts of the scene).
-    PolarScan a = s, b = s;
-    a.valid.assign(s.azimuths, 0);
-    b.valid.assign(s.azimuths, 0);
-    const int rows = s.azimuths / 4;
-    for (int r = 0; r < s.azimuths; ++r) {
-      const bool orig = s.valid.empty() || s.valid[r];
-      const bool first = (std::min(r / std::max(rows, 1), 3) % 2) == 0;
-      (first ? a : b).valid[r] = orig ? 1 : 0;
-    }
-    fit.push_back(std::move(a));
-    holdout.push_back(std::move(b));
-  }
-}
-
 SensorConfig fitRangeCurves(const sim::RealismStats& real, const SensorConfig& start,
                             const sim::PhysicsConfig& physics, const AppearanceOptions& opt,
                             std::vector<std::string>* log) {

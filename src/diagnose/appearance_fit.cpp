@@ -39,7 +39,7 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
   // Everything is fitted on `real`, the fit part; the held-out part only checks the result.
   std::vector<PolarScan> real, holdout;
   if (opt.holdout)
-    splitHoldout(recording, real, holdout);
+    splitHoldout(recording, real, holdout, parseHoldoutSplit(opt.holdout_split));
   else
     real = recording;
   rep.fit_scans = int(real.size());

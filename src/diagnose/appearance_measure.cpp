@@ -60,7 +60,12 @@ void measurePeaks(const PolarScan& s, const std::array<double, kBands>& floor, i
                   PeakSums& ps) {
   const int N = s.azimuths, M = s.bins;
   const int R = 6, B = 40;  // isolation window (rows, bins)
+  // A peak's window must lie in valid rows: a held-out row (masked and zeroed) would cut it.
+  std::vector<int> bad_before(size_t(N) + 1, 0);
+  for (int a = 0; a < N; ++a)
+    bad_before[size_t(a) + 1] = bad_before[size_t(a)] + (!s.valid.empty() && !s.valid[size_t(a)]);
   for (int a = R; a < N - R; ++a) {
+    if (bad_before[size_t(a + R) + 1] != bad_before[size_t(a - R)]) continue;
     const uint8_t* row = s.row(a);
     for (int b = B; b < M - B; ++b) {
       const int k = bandOf(s.rangeOfBin(b));
@@ -123,6 +128,7 @@ double behindShare(const PolarScan& s, const std::array<double, kBands>& floor) 
   const int gap = int(std::ceil(2.0 / s.range_resolution));
   const int span = int(30.0 / s.range_resolution);
   for (int a = 0; a < s.azimuths; ++a) {
+    if (!s.valid.empty() && !s.valid[size_t(a)]) continue;
     const uint8_t* row = s.row(a);
     int hit = -1;
     for (int b = 0; b < s.bins; ++b) {
@@ -185,15 +191,21 @@ AppearanceFigures measureAppearance(const std::vector<PolarScan>& scans) {
         reps.push_back(r);
         continue;
       }
+      // Only the quarter's valid rows (an interleaved split masks every other block of it).
+      std::vector<int> keep;
+      for (int a = q * rows; a < (q + 1) * rows; ++a)
+        if (!has_valid || full.valid[a]) keep.push_back(a);
       PolarScan s;
-      s.resize(rows, full.bins);
+      s.resize(int(keep.size()), full.bins);
       s.range_resolution = full.range_resolution;
       s.range_offset = full.range_offset;
-      std::copy(full.row(q * rows), full.row(q * rows) + size_t(rows) * full.bins, s.power.begin());
+      for (size_t i = 0; i < keep.size(); ++i)
+        std::copy(full.row(keep[i]), full.row(keep[i]) + full.bins, s.power.begin() + long(i) * full.bins);
+      const double per_rotation = double(full.azimuths) / double(keep.size());
       Replicate r;
       std::vector<std::vector<double>> h(kBands, std::vector<double>(256, 0.0));
       double rnear = 0, rnear_n = 0;
-      for (int a = 0; a < rows; ++a) {
+      for (int a = 0; a < s.azimuths; ++a) {
         const uint8_t* row = s.row(a);
         double rs = 0, rn = 0;
         for (int b = 0; b < s.bins; ++b) {
@@ -210,7 +222,7 @@ AppearanceFigures measureAppearance(const std::vector<PolarScan>& scans) {
       if (rnear_n > 0) r.near = rnear / rnear_n - r.floor[0];
       double cf[4] = {0, 0, 0, 0};
       sim::countPlainCaCfar(s, sim::kBandEdges[0], sim::kBandEdges[kBands], cf);
-      for (int k = 0; k < kBands; ++k) r.cfar[k] = std::log10(1.0 + Q * cf[k]);
+      for (int k = 0; k < kBands; ++k) r.cfar[k] = std::log10(1.0 + per_rotation * cf[k]);
       reps.push_back(r);
     }
   }
@@ -242,6 +254,8 @@ AppearanceFigures measureAppearance(const std::vector<PolarScan>& scans) {
         sub.range_resolution = s.range_resolution;
         sub.range_offset = s.range_offset;
         std::copy(s.row(a0), s.row(a0) + size_t(a1 - a0) * s.bins, sub.power.begin());
+        if (s.valid.size() == size_t(s.azimuths))  // masked (held-out) rows: no peak window there
+          std::copy(s.valid.begin() + a0, s.valid.begin() + a1, sub.valid.begin());
         PeakSums ps;
         measurePeaks(sub, fl, top, ps);
         Replicate& r = reps[ri + q];

@@ -341,7 +341,7 @@ AppearanceOptions withReferenceScene(const AppearanceOptions& opt,
   // The scene comes from the fit part only, so the held-out figures stay a check.
   std::vector<PolarScan> fit, holdout;
   if (opt.holdout)
-    splitHoldout(recording, fit, holdout);
+    splitHoldout(recording, fit, holdout, parseHoldoutSplit(opt.holdout_split));
   else
     fit = recording;
   o.scene_scans = std::make_shared<const std::vector<PolarScan>>(std::move(fit));

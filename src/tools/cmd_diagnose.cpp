@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -47,12 +48,29 @@ struct DiagnoseArgs {
   bool scene_subbin = false;
   bool scene_clean = false;  // own scene by CLEAN instead of one scatterer per local maximum
   bool fit_spread = false;
+  std::string holdout_split = diagnose::kDefaultHoldoutSplit;
+  bool split_survey = false;  // only measure the real halves' difference under candidate splits
 };
+
+/// The real halves' own difference under the candidate splits (docs/diagnose_holdout.md, tenth
+/// round): <out>/appearance/split_survey.md and stdout.
+void splitSurvey(const std::vector<PolarScan>& scans, const std::string& dir) {
+  std::vector<diagnose::HoldoutSplit> c;
+  for (const char* n : {"contiguous", "scans", "blocks:2", "blocks:4", "blocks:8", "blocks:16",
+                        "blocks:20", "blocks:24", "blocks:32", "blocks:40", "blocks:50", "blocks:100"})
+    c.push_back(diagnose::parseHoldoutSplit(n));
+  const std::string md = diagnose::splitSurveyMarkdown(diagnose::surveySplits(scans, c));
+  fs::create_directories(dir);
+  if (!(std::ofstream(fs::path(dir) / "split_survey.md") << md))
+    throw std::runtime_error(dir + "/split_survey.md: cannot write");
+  std::cout << md;
+}
 
 /// The appearance stage (no world or trajectory needed): findings, fitted sensor file, plots
 /// into <out>/appearance.
 void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
                    const sim::PhysicsConfig& physics) {
+  if (a.split_survey) return splitSurvey(scans, (fs::path(a.out) / "appearance").string());
   sim::SensorConfig s = a.sensor.empty() ? sim::SensorConfig{} : sim::SensorConfig::loadNamed(a.sensor);
   // The re-simulation must have the recording's geometry.
   const PolarScan& p = scans.front();
@@ -75,6 +93,7 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   opt.scene_refine_passes = a.scene_refine;
   opt.scene_range_subbin = a.scene_subbin;
   opt.fit_spread_bands = a.fit_spread;
+  opt.holdout_split = a.holdout_split;
   if (!a.gain_chain.empty()) {
     if (opt.scene != "combined")
       throw std::invalid_argument("--appearance-gain-chain needs --appearance-scene combined");
@@ -311,6 +330,18 @@ SPINRADAR_COMMAND(
       app.add_flag("--appearance-no-holdout", a->no_holdout,
                    "Fit the appearance on the whole recording (default: fit on the first half of "
                    "the scans, or quarters 0 and 2 of a single scan, check on the rest)");
+      app.add_option("--appearance-split", a->holdout_split,
+                     "How the appearance fit splits the recording: blocks:N (azimuth blocks of N "
+                     "rows, N even, alternate fit / held out in every scan), scans (every other "
+                     "scan) or contiguous (first half of the scans, or quarters 0+2 of one scan; "
+                     "the ninth round's); default by the rule in docs/diagnose_holdout.md")
+          ->check(CLI::Validator([](std::string& v) -> std::string {
+            try { return diagnose::parseHoldoutSplit(v), std::string(); } catch (const std::invalid_argument& e) { return e.what(); }
+          }, "", "SPLIT"))
+          ->capture_default_str();
+      app.add_flag("--appearance-split-survey", a->split_survey,
+                   "Only measure the real halves' own difference under candidate splits (the "
+                   "held-out check's noise floor) into <out>/appearance/split_survey.md");
       app.add_flag("--appearance-fit-floor", a->fit_floor,
                    "Also fit each band's noise floor (lower half of the counts) in the per-band "
                    "calibration: tells receiver noise from weak clutter (docs/diagnose.md)");

@@ -151,6 +151,8 @@ fail_row "--range-resolution 0" "--range-resolution: 0 must be greater than 0" \
   "$bin" odometry -i "$in/rec" -o "$o/p.csv" --range-resolution 0
 fail_row "simulate --scans -1" "--scans: -1 is below the minimum 1" \
   "$bin" simulate --scene city --scans -1 --out "$o/s"
+fail_row "diagnose --appearance-split blocks:7" "blocks:7.*must be an even" \
+  "$bin" diagnose --recording "$in/rec" --out "$o/d" --appearance-split blocks:7
 fail_row "diagnose --max-scans 0" "--max-scans: 0 is not a count of scans" \
   "$bin" diagnose --recording "$in/rec" --out "$o/d" --max-scans 0
 fail_row "localize --global-stride 0" "--global-stride: 0 is below the minimum 1" \

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "spinradar/core/polar_scan.hpp"
+#include "spinradar/diagnose/appearance_split.hpp"
 #include "spinradar/sim/physics.hpp"
 #include "spinradar/sim/realism.hpp"
 #include "spinradar/sim/scene.hpp"
@@ -159,6 +160,8 @@ struct AppearanceOptions {
   bool fit_glint = true;
   /// Fit on part of the recording and check on the rest (splitHoldout).
   bool holdout = true;
+  /// How: "contiguous", "scans" or "blocks:N" (parseHoldoutSplit, appearance_split.hpp).
+  std::string holdout_split = kDefaultHoldoutSplit;
   /// Also render the fitted sensor with each part's own scene, to tell a held-out gap of the
   /// scene from one of the sensor (detail::holdoutSceneCheck; needs realism and holdout).
   bool holdout_scene_check = true;
@@ -233,6 +236,10 @@ struct AppearanceReport {
   double worst_gap_before = 0, worst_gap_after = 0;
   double worst_holdout_before = 0, worst_holdout_after = 0;
   int fit_scans = 0, holdout_scans = 0;  ///< scans (or masked half scans) in each part
+  /// The split used (appearance_split.hpp; "auto" resolved), set by writeAppearanceReport.
+  std::string holdout_split;
+  /// The real halves' own difference: largest over the fitted figures of |held out - fit| / fit.
+  double realHalvesDifference(std::string* figure = nullptr) const;
   /// The fitted sensor rendered with the fit part's and the held-out part's own scenes, their
   /// worst gaps against those parts, and every fitted figure of the held-out part with its verdict.
   sim::RealismStats realism_fit_scene, realism_holdout_scene;
@@ -280,9 +287,9 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real,
                                     const sim::PhysicsConfig& physics,
                                     const AppearanceOptions& opt = {});
 
-/// Splits a recording for a held-out check: several scans: the first half (rounded up) to fit,
-/// the rest held out; one scan: its quarters 0 and 2 to fit, 1 and 3 held out (rows masked
-/// through PolarScan::valid; realism counts stay per full rotation).
+/// The ninth round's split ("contiguous", appearance_split.hpp): several scans: the first half
+/// (rounded up) to fit, the rest held out; one scan: its quarters 0 and 2 to fit, 1 and 3 held
+/// out (rows masked through PolarScan::valid and zeroed; realism counts stay per full rotation).
 void splitHoldout(const std::vector<PolarScan>& scans, std::vector<PolarScan>& fit,
                   std::vector<PolarScan>& holdout);
 
