@@ -104,10 +104,11 @@ void markOwnSceneFindings(std::vector<AppearanceFinding>& findings,
                           std::vector<std::string>& notes);
 
 /// Glint terms (physics glint_across, glint_along, azimuth_jitter; glint_terms.hpp) of the
-/// consecutive scans `real` against cur/phys: their findings and a note with the spread
-/// before/after go to `rep`; the named ones are set in the sensor's physics (`cur.physics`, what a
-/// calibrated sensor file carries), the others removed from it.
+/// scans `real` (pairs `stride` rotations apart; the reference pairs too) against cur/phys: their
+/// findings and a note with the spread before/after go to `rep`; the named ones are set in the
+/// sensor's physics (`cur.physics`, what a calibrated sensor file carries), the others removed.
 void appendGlint(const std::vector<PolarScan>& real, sim::SensorConfig& cur,
-                 sim::PhysicsConfig& phys, const AppearanceOptions& opt, AppearanceReport& rep);
+                 sim::PhysicsConfig& phys, const AppearanceOptions& opt, AppearanceReport& rep,
+                 int stride = 1);
 
 }  // namespace spinradar::diagnose::detail

@@ -38,10 +38,11 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
   AppearanceReport rep;
   // Everything is fitted on `real`, the fit part; the held-out part only checks the result.
   std::vector<PolarScan> real, holdout;
-  if (opt.holdout)
-    splitHoldout(recording, real, holdout, parseHoldoutSplit(opt.holdout_split));
-  else
-    real = recording;
+  HoldoutSplit sp = parseHoldoutSplit(opt.holdout_split);
+  if (opt.holdout && sp.kind == HoldoutSplit::kAuto) sp = chooseHoldoutSplit(recording);
+  if (opt.holdout) splitHoldout(recording, real, holdout, sp);
+  else real = recording;
+  const int glint_stride = opt.holdout && sp.kind == HoldoutSplit::kScans ? 2 : 1;  // fit scans' gap
   rep.fit_scans = int(real.size());
   rep.holdout_scans = int(holdout.size());
   rep.base = sensor;
@@ -381,10 +382,10 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
       rep.after = figuresOf(cur, phys);
     }
   }
-  // Glint terms (appearance_glint.cpp) on every consecutive pair of the recording, held-out part
-  // too: the spread is a figure of pairs, and halving three scans leaves one (one-scan samples,
-  // split by azimuth, have none either way). Its check is `spinradar spread` on the real samples.
-  if (opt.fit_glint) detail::appendGlint(recording, cur, phys, opt, rep);
+  // Glint terms (appearance_glint.cpp) on the fit part's pairs only: under the "scans" split its
+  // scans are 2 rotations apart, and so are the reference's (one-scan samples have no pair: not
+  // identifiable). Its check is `spinradar spread` on the real samples.
+  if (opt.fit_glint) detail::appendGlint(real, cur, phys, opt, rep, glint_stride);
   if (opt.scene == "recording" && !opt.hold_gain_chain) detail::markOwnSceneFindings(rep.findings, rep.notes);
   std::stable_sort(rep.findings.begin(), rep.findings.end(),
                    [](const AppearanceFinding& a, const AppearanceFinding& b) {

@@ -1,5 +1,7 @@
 // Appearance stage: the glint terms (glint_terms.hpp) added to the catalogue's findings.
+#include <algorithm>
 #include <cstdio>
+#include <string>
 
 #include "appearance_detail.hpp"
 #include "spinradar/diagnose/glint_terms.hpp"
@@ -7,9 +9,15 @@
 namespace spinradar::diagnose::detail {
 
 void appendGlint(const std::vector<PolarScan>& real, sim::SensorConfig& cur,
-                 sim::PhysicsConfig& phys, const AppearanceOptions& opt, AppearanceReport& rep) {
+                 sim::PhysicsConfig& phys, const AppearanceOptions& opt, AppearanceReport& rep,
+                 int stride) {
   GlintTermsOptions go;
   go.ref.seed = opt.seed;
+  // Pairs `stride` rotations apart, in the recording and the reference alike (the motion between
+  // the scans of a pair adds spread); the alignment search widens with the motion.
+  go.ref.spread.stride = std::max(stride, 1);
+  go.ref.spread.search *= go.ref.spread.stride;
+  go.ref.spread.search_yaw_deg *= go.ref.spread.stride;
   go.z_min = opt.z_min;
   // The reference drives the city route: with the drive's physics (motion distortion, Doppler,
   // movers), as the real samples were recorded and as `spinradar spread` / `realism` and the
@@ -40,24 +48,27 @@ void appendGlint(const std::vector<PolarScan>& real, sim::SensorConfig& cur,
     rep.findings.push_back(f);
   }
   if (!g.measured) {
-    rep.notes.push_back("Glint not identifiable: the recording has no two distinct consecutive scans.");
+    rep.notes.push_back(stride > 1 ? "Glint not identifiable: the fit part has no two scans " +
+                                         std::to_string(stride) + " rotations apart."
+                                   : "Glint not identifiable: the fit part has no two distinct consecutive scans.");
     return;
   }
   for (const GlintTerm* t : {&g.across, &g.along, &g.jitter})
     if (t->verdict != "not identifiable") cur.physics.erase(t->key);
   for (const auto& [k, v] : g.named()) cur.physics[k] = v;
-  char buf[600];
+  char buf[700];
   std::snprintf(buf, sizeof buf,
-                "Glint: returns matched between consecutive scans spread %.3f m across the beam "
+                "Glint (fit part; pairs %d rotation(s) apart, reference too): returns matched "
+                "between scans spread %.3f m across the beam "
                 "(%.3f along; %d pairs), the model %.3f (%.3f) without glint terms and %.3f (%.3f) "
                 "with the named ones: glint_across %.3f +- %.3f m (%s), glint_along %.3f +- %.3f m "
-                "(%s), azimuth_jitter %.3f +- %.3f deg (%s); reference: %d x %d consecutive scans "
-                "of the %s route.",
-                g.real.all.tangential, g.real.all.radial, g.real.pairs, g.base.all.tangential,
+                "(%s), azimuth_jitter %.3f +- %.3f deg (%s); reference: %d x %d scans "
+                "(%d apart) of the %s route.",
+                go.ref.spread.stride, g.real.all.tangential, g.real.all.radial, g.real.pairs, g.base.all.tangential,
                 g.base.all.radial, g.after.all.tangential, g.after.all.radial, g.across.value,
                 g.across.stddev, g.across.verdict.c_str(), g.along.value, g.along.stddev,
                 g.along.verdict.c_str(), g.jitter.value, g.jitter.stddev, g.jitter.verdict.c_str(),
-                go.ref.segments, go.ref.scans, go.ref.scene.c_str());
+                go.ref.segments, go.ref.scans, go.ref.spread.stride, go.ref.scene.c_str());
   rep.notes.push_back(buf);
 }
 

@@ -40,12 +40,15 @@ MatchedSpread referenceSpread(const sim::SensorConfig& sensor, const sim::Physic
   sim::Scene sc = sim::builtinScene(opt.scene);
   sim::Simulator s(std::move(sc.world), std::move(sc.trajectory), sensor, physics, opt.seed);
   const int total = s.scanCount();
-  const int n = std::min(opt.scans, total), S = std::max(1, opt.segments);
+  // Scans opt.spread.stride apart, as the recording's pairs (the motion between them adds spread).
+  const int k_gap = std::max(1, opt.spread.stride);
+  const int n = std::min(opt.scans, (total - 1) / k_gap + 1), S = std::max(1, opt.segments);
+  const int width = (n - 1) * k_gap + 1;
   std::vector<MatchedSpread> seg;
   for (int k = 0; k < S; ++k) {
-    const int first = std::clamp(int((k + 0.5) * total / S) - n / 2, 0, total - n);
+    const int first = std::clamp(int((k + 0.5) * total / S) - width / 2, 0, total - width);
     std::vector<PolarScan> scans;
-    for (int i = first; i < first + n; ++i) scans.push_back(s.renderScan(i));
+    for (int i = first; i < first + width; i += k_gap) scans.push_back(s.renderScan(i));
     seg.push_back(measureMatchedSpread(scans, nullptr, opt.spread));
   }
   // Average of the segments: matches-weighted per band; the pooled figure's standard error from

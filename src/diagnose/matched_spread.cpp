@@ -91,14 +91,16 @@ double robustStd(std::vector<double> v) {
 // Standard error of the MAD-based std of n normal samples (asymptotic efficiency 0.37).
 double madSe(double s, size_t n) { return n > 1 ? 1.167 * s / std::sqrt(double(n)) : NAN; }
 
-// Scan b follows scan a directly: later, and by at most 1.6 rotations when the row stamps give
-// the rotation time (scans spread over a route, or masked copies of one scan, are no pair).
-bool consecutive(const PolarScan& a, const PolarScan& b) {
+// Scan b follows scan a directly (stride 1): later, and by at most 1.6 rotations when the row
+// stamps give the rotation time (scans spread over a route, or masked copies of one scan, are no
+// pair); with stride k > 1, by k - 0.6 to k + 0.6 rotations.
+bool consecutive(const PolarScan& a, const PolarScan& b, int stride) {
   const int64_t gap = b.firstStamp() - a.firstStamp();
   if (gap <= 0) return false;
   const int64_t span = a.lastStamp() - a.firstStamp();
   if (span <= 0 || a.azimuths < 2) return true;
-  return double(gap) <= 1.6 * double(span) * a.azimuths / (a.azimuths - 1);
+  const double rot = double(span) * a.azimuths / (a.azimuths - 1), k = std::max(stride, 1);
+  return double(gap) <= (k + 0.6) * rot && (k == 1 || double(gap) >= (k - 0.6) * rot);
 }
 
 }  // namespace
@@ -246,7 +248,7 @@ MatchedSpread measureMatchedSpread(const std::vector<PolarScan>& scans,
   std::vector<double> all_t, all_r;
   Eigen::Matrix3d prev = Eigen::Matrix3d::Identity();
   for (size_t i = 0; i + 1 < scans.size(); ++i) {
-    if (!consecutive(scans[i], scans[i + 1])) continue;
+    if (!consecutive(scans[i], scans[i + 1], opt.stride)) continue;
     const auto &a = ret[i], &b = ret[i + 1];
     const Eigen::Matrix3d T = motions ? (*motions)[i] : alignReturns(a, b, prev, opt);
     prev = T;

@@ -7,7 +7,8 @@
 //   as the real halves' difference under the contiguous split, not under interleaved blocks;
 // - a concealed sensor change in the held-out rows (receiver noise +6 dB) is still caught as
 //   "model" by the held-out check with interleaved blocks;
-// - the held-out rows altered: the fit (sensor, fit-part figures) does not change.
+// - the held-out rows altered: the fit (sensor, fit-part figures) does not change; the glint
+//   terms too, fitted on the fit part's pairs (scans 2 apart under the "scans" split).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -27,9 +28,9 @@ namespace spinradar::diagnose {
 namespace {
 
 std::vector<PolarScan> render(const sim::SensorConfig& s, const std::vector<int>& scans,
-                              uint64_t seed) {
+                              uint64_t seed, const sim::PhysicsConfig& physics = {}) {
   sim::Scene sc = sim::builtinScene("out_and_back");
-  const sim::Simulator sim(std::move(sc.world), std::move(sc.trajectory), s, {}, seed);
+  const sim::Simulator sim(std::move(sc.world), std::move(sc.trajectory), s, physics, seed);
   std::vector<PolarScan> out;
   for (const int k : scans) out.push_back(sim.renderScan(k));
   return out;
@@ -215,6 +216,50 @@ TEST(AppearanceSplit, HeldOutRowsDoNotMoveTheFit) {
       EXPECT_EQ(a.worst_gap_after, b.worst_gap_after) << split << " " << scene;
       EXPECT_NE(a.worst_holdout_after, b.worst_holdout_after) << split << " " << scene;
     }
+  }
+}
+
+// Glint terms: fitted on pairs of the fit part only. Consecutive scans, every held-out scan
+// replaced by another receiver's with strong glint (with the glint fit on the whole recording,
+// its pairs 300-301, 301-302, ... read them, and the terms moved).
+TEST(AppearanceSplit, HeldOutScansDoNotMoveTheGlintTerms) {
+  const sim::SensorConfig s = testing::hundredMetreSensor();
+  sim::SensorConfig other = s;
+  other.noise_floor_db += 8.0;
+  other.radar_constant_db -= 5.0;
+  const std::vector<int> idx = {300, 301, 302, 303, 304};
+  const auto rec = render(s, idx, 3);
+  sim::PhysicsConfig glinty;
+  glinty.extra["glint_across"] = 0.3, glinty.extra["glint_along"] = 0.3;
+  const auto alt = render(other, idx, 9, glinty);
+  auto glint = [](const AppearanceReport& r) {
+    std::string out;
+    for (const auto& f : r.findings)
+      if (f.parameter == "glint_across" || f.parameter == "glint_along" || f.parameter == "azimuth_jitter")
+        out += f.parameter + "=" + std::to_string(f.value) + "+-" + std::to_string(f.stddev) + " " + f.verdict + "; ";
+    for (const auto& n : r.notes)
+      if (n.rfind("Glint", 0) == 0) out += n;
+    return out;
+  };
+  // "scans": fit 300, 302, 304 (pairs 2 apart), held out 301, 303; "contiguous": fit 300-302.
+  for (const char* split : {"scans", "contiguous"}) {
+    AppearanceOptions opt = testing::quickAppearanceOptions();
+    opt.iterations = 1;
+    opt.curve_iterations = 0;
+    opt.scene = "city";
+    opt.fit_glint = true;
+    opt.holdout_split = split;
+    const bool scans = std::string(split) == "scans";
+    std::vector<PolarScan> altered = rec;
+    for (size_t i = 0; i < rec.size(); ++i)
+      if (scans ? i % 2 == 1 : i >= 3) altered[i] = alt[i];
+    const AppearanceReport a = diagnoseAppearance(rec, s, {}, opt);
+    const AppearanceReport b = diagnoseAppearance(altered, s, {}, opt);
+    const std::string ga = glint(a);
+    EXPECT_NE(ga.find("Glint (fit part; pairs " + std::string(scans ? "2" : "1")), std::string::npos) << ga;
+    EXPECT_EQ(ga, glint(b)) << split;
+    EXPECT_EQ(a.fitted.toJson().dump(), b.fitted.toJson().dump()) << split;
+    EXPECT_NE(a.worst_holdout_after, b.worst_holdout_after) << split;
   }
 }
 

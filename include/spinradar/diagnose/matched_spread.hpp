@@ -24,6 +24,9 @@ struct SpreadOptions {
   double search = 4.0;           ///< m, half width of the coarse translation search
   double search_yaw_deg = 4.0;   ///< half width of the coarse yaw search
   int icp_iterations = 30;
+  /// Pairs are scans this many rotations apart (1: consecutive; 2: the fit part of the appearance
+  /// stage's "scans" split, every other scan). A reference for such pairs must use the same gap.
+  int stride = 1;
 };
 
 /// One range band (sim::kBandEdges: 2.5-10, 10-25, 25-50, 50-100 m).
@@ -51,7 +54,8 @@ std::vector<Eigen::Vector2d> spreadReturns(const PolarScan& scan, const SpreadOp
 /// Spread of the returns matched between scans i and i+1. `motions`, when not null, holds the
 /// pose of scan i+1 in the frame of scan i for each pair (size scans - 1); otherwise it is
 /// estimated. Only consecutive scans are a pair: later, by at most 1.6 rotations when the row
-/// stamps span the rotation (not masked copies of one scan, not scans spread over a route).
+/// stamps span the rotation (not masked copies of one scan, not scans spread over a route); with
+/// opt.stride k > 1, later by k - 0.6 to k + 0.6 rotations.
 MatchedSpread measureMatchedSpread(const std::vector<PolarScan>& scans,
                                    const std::vector<Eigen::Matrix3d>* motions = nullptr,
                                    const SpreadOptions& opt = {});
