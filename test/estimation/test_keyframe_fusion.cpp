@@ -14,6 +14,7 @@
 #include <Eigen/Cholesky>
 
 #include "support/noisy_prior.hpp"
+#include "support/glint_scene.hpp"
 #include "support/synthetic_scene.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/estimation/keyframe_tracker.hpp"
@@ -35,16 +36,7 @@ struct Drive {
 };
 
 Drive drive(uint32_t seed, double glint, int fusion, int scans = 120) {
-  SceneOptions o;
-  o.landmarks = 900;
-  o.min_range = 4.0;
-  o.max_range = 140.0;
-  o.visible_range = 100.0;
-  o.range_sigma = std::hypot(0.03, glint);
-  o.azimuth_sigma = 0.001;
-  o.tangential_sigma = glint;
-  o.clutter = 100;
-  o.seed = seed;
+  const SceneOptions o = spinradar::testing::glintSceneOptions(seed, glint);
   const Eigen::Vector3d v(6.0, 0.0, 0.15);
   SyntheticScene scene(o, {v});
   EstimatorConfig cfg;

@@ -12,6 +12,7 @@
 #include <random>
 
 #include "support/noisy_prior.hpp"
+#include "support/glint_scene.hpp"
 #include "support/synthetic_scene.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/estimation/keyframe_tracker.hpp"
@@ -34,16 +35,7 @@ struct Drive {
 /// `scans` scans at 6 m/s turning at 0.15 rad/s (a 40 m circle) through landmarks; the
 /// frame-to-frame prior is the truth with Gaussian errors of its stated covariance.
 Drive drive(uint32_t seed, double glint, int submap, double floor_gate, int scans = 120) {
-  SceneOptions o;
-  o.landmarks = 900;
-  o.min_range = 4.0;
-  o.max_range = 140.0;
-  o.visible_range = 100.0;
-  o.range_sigma = std::hypot(0.03, glint);  // glint along the beam, on the range noise
-  o.azimuth_sigma = 0.001;                  // azimuth peaks: sub-row azimuths
-  o.tangential_sigma = glint;               // and across it
-  o.clutter = 100;
-  o.seed = seed;
+  const SceneOptions o = spinradar::testing::glintSceneOptions(seed, glint);
   const Eigen::Vector3d v(6.0, 0.0, 0.15);
   SyntheticScene scene(o, {v});
   EstimatorConfig cfg;
