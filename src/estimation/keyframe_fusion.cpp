@@ -1,7 +1,7 @@
 // EstimatorConfig::keyframe_fusion (issue 19): a scan that becomes the keyframe is also
 // registered against the keyframes before the current one, and its pose fused.
 //
-// Why (docs/diagnose_sensor_columns.md, ninth and tenth rounds): the keyframe chain hands each
+// Why (docs/sensor_columns/, ninth and tenth rounds): the keyframe chain hands each
 // switch's registration error on (heading 0.06 deg rms for weak registrations on straights,
 // 0.11-0.12 deg for proximity ICP in turns), and the Oxford and MulRan sensor models switch
 // keyframes 105-126 times in 400 scans: with the truth at every switch the drift is 0.04-0.05 %
@@ -87,7 +87,7 @@ bool KeyframeTracker::registerToPast(const FeatureFrame& cur, PastKeyframe& pk, 
   };
   // Descriptor matches only, at kMinInliers: the proximity ICP against the keyframe before
   // (turns) and registrations with kMinWeakInliers were measured worse than the chain they
-  // would be fused with (docs/diagnose_sensor_columns.md, tenth round).
+  // would be fused with (docs/sensor_columns/round10a_glint_registration_fusion.md).
   bool ok = false;
   if (!cur.descriptors.empty() && !key_desc_.empty()) {
     matchDescriptors(key_desc_, cur.descriptors, nndr_, matches_);

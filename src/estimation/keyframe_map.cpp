@@ -83,7 +83,7 @@ void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d&
   ++switches_;
 }
 
-// Why (issue 19, docs/diagnose_sensor_columns.md, eighth round): every scan registered to a
+// Why (issue 19, docs/sensor_columns/round08_glint.md): every scan registered to a
 // keyframe shares the scatter (glint) of its map's returns, and the keyframe switch hands it
 // on. The mean of a return's positions in the last N keyframes (moved into the new keyframe's
 // frame with the chained poses) scatters sqrt(N) less and ties the new map to the earlier

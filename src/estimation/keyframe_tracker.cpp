@@ -145,7 +145,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
       // 2 0.069 -> 0.063; city_wide, tight_turns, city_oxford (glint) unchanged (+-0.002);
       // city_noise14 0.076 -> 0.080. Drift: city_oxford layouts 1 / 2 0.32 / 0.25 -> 0.28 /
       // 0.18 %, but city_noise14 0.13 -> 0.18 % (one turn's keyframes fell differently): an
-      // option, off by default (docs/diagnose_sensor_columns.md, ninth round). With the last
+      // option, off by default (docs/sensor_columns/round09_weak_switches.md). With the last
       // resort settled too RADIATE consistency went 0.191 -> 0.199 deg.
       for (const double g : {kProximityRegate, settle ? config_.proximity_settle_gate : 0.0}) {
         for (int r = 0; ok && g > 0.0 && r < kProximityIterations; ++r) {
@@ -175,7 +175,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     // that prediction (12 columns pooled). Such a weak registration is kept, and the scan
     // becomes the keyframe: registering later scans to the old keyframe took the later
     // switches at worse registrations (accepting 12 inliers throughout: city_narrow 0.18 ->
-    // 0.58 %, tight_turns 0.12 -> 0.19 %; docs/diagnose_sensor_columns.md).
+    // 0.58 %, tight_turns 0.12 -> 0.19 %; docs/sensor_columns/round06_far_field_not_refound.md).
     if (!registered && !proximity) {
       T = T_odo;
       xi = xi_prior;

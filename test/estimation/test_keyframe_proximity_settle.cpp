@@ -3,9 +3,10 @@
 // scan (a turn), the scan is registered by nearest points to the prediction: 1.5 m, then
 // 0.6 m until it settles, then one re-association at 0.3 m. Under the Oxford and MulRan
 // sensor models most keypoints are clutter that is not found again
-// (docs/diagnose_sensor_columns.md), and at 0.6 m many pair by chance and hold the pose near
-// the prediction; one re-association at 0.3 m keeps much of that (city_oxford layouts 1 / 2:
-// those registrations 0.125 / 0.110 deg rms off in yaw; settled at 0.3 m 0.099 / 0.076).
+// (docs/sensor_columns/round06_far_field_not_refound.md), and at 0.6 m many pair by chance and
+// hold the pose near the prediction; one re-association at 0.3 m keeps much of that
+// (city_oxford layouts 1 / 2: those registrations 0.125 / 0.110 deg rms off in yaw; settled at
+// 0.3 m 0.099 / 0.076; docs/sensor_columns/round09_weak_switches.md).
 // Known truth: a synthetic drive (straight, a 0.6 rad/s turn, straight) through sparse
 // landmarks and dense clutter, descriptors failing in the turn and the pair prior 0.5 deg
 // off per step; the heading error against the truth with and without the settling.

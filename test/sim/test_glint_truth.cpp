@@ -1,5 +1,6 @@
-// Glint against the simulator's truth (issue 19, docs/diagnose_sensor_columns.md, tenth round):
-// on city_oxford_glint0.14 every keyframe registration is 0.12-0.15 deg off in yaw on straights,
+// Glint against the simulator's truth (issue 19, tenth round,
+// docs/sensor_columns/round10a_glint_registration_fusion.md): on city_oxford_glint0.14 every
+// keyframe registration is 0.12-0.15 deg off in yaw on straights,
 // and the question was whether the simulator moves a scan's returns together (a per-scan
 // rotation or shift common to its targets, e.g. one draw per scan instead of per scatterer).
 // Here the Oxford sensor model renders isolated point targets with 0.14 m glint on a straight
