@@ -353,7 +353,12 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     // EstimatorConfig::keyframe_fusion: register the new keyframe against the earlier ones
     // too and fuse (keyframe_fusion.cpp); its published pose and covariance follow.
     Eigen::Matrix3d M_k = T_wj_ * E_j * T_jk;
-    if (config_.keyframe_fusion > 0 && !still && fuseWithPast(cur, c, T_jk, C_jk_acc, M_k, P_m_next)) {
+    // EstimatorConfig::keyframe_graph instead: a pose graph over the window (keyframe_graph.cpp).
+    if (config_.keyframe_graph > 0) new_edges_.assign(1, GraphEdge{key_stamp_, T_jk, C_jk_acc});
+    const bool graphed = config_.keyframe_graph > 0 && !still &&
+                         solveGraph(cur, c, T_jk, C_jk_acc, M_k, P_m_next);
+    if (graphed || (config_.keyframe_graph == 0 && config_.keyframe_fusion > 0 && !still &&
+                    fuseWithPast(cur, c, T_jk, C_jk_acc, M_k, P_m_next))) {
       const Eigen::Matrix3d E_k = se2::exp(-c * xi_k);
       const Eigen::Matrix3d Le = se2::leftPerturbationToXyYaw(E_k);
       const Eigen::Matrix3d C_e = Le * (c * c * Cxi_k_acc) * Le.transpose();
@@ -365,6 +370,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     key_xi_cov_ = xi_cov_pub;
     key_xi_cov_(2, 2) += dw2 / 3.0;  // as above: the keyframe map was moved with that yaw rate
     makeKeyframe(cur, xi_key, c, T_w, P);
+    key_edges_.swap(new_edges_);
     key_pair_xi_ = pair.velocity;
     key_ramp_ = pair_ramp;
     P_jm_ = P_m_next;

@@ -41,7 +41,8 @@
   X(double, floor_gate, 0.0, 0.0, 20.0, "x floor", "keyframe: the registration's inlier gate is at least this multiple of its measured tangential noise floor (0: inlier_threshold only)") \
   X(double, yaw_rate_sigmas, 4.0, 0.0, 20.0, "x sigma", "keyframe: a registration's own yaw rate replaces the pair velocity's (in its published pose and its keyframe map) only when they differ by this multiple of the difference's standard deviation as well as by 0.05 rad/s (0: by 0.05 rad/s only)") \
   X(double, proximity_settle_gate, 0.0, 0.0, 1.5, "m", "keyframe: the proximity ICP (keyframe turned away from the scan, descriptors failed) iterates on at this narrower gate until it settles, after its 0.6 m iterations (0: one re-association at 0.3 m)") \
-  X(int, keyframe_fusion, 0, 0, 2, "", "keyframe: a scan that becomes the keyframe is also registered against the last keyframe_fusion keyframes before the current one, and its pose is the information-weighted fusion of those registrations with the chained one (each extra estimate gated by chi-square against it; 0: the chained pose only)")
+  X(int, keyframe_fusion, 0, 0, 2, "", "keyframe: a scan that becomes the keyframe is also registered against the last keyframe_fusion keyframes before the current one, and its pose is the information-weighted fusion of those registrations with the chained one (each extra estimate gated by chi-square against it; 0: the chained pose only)") \
+  X(int, keyframe_graph, 0, 0, 10, "", "keyframe: a scan that becomes the keyframe is registered against each of the last keyframe_graph keyframes (weak and proximity registrations too, each gated by chi-square against the chained pose), and the window's poses are solved as a pose graph (information-weighted least squares on SE(2), the oldest held); the new keyframe takes its solved pose, published poses stay causal (0: the chained pose only)")
 // clang-format on
 
 namespace spinradar {

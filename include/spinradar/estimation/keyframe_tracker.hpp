@@ -74,6 +74,7 @@ class KeyframeTracker {
     has_key_ = has_last_stamp_ = false;
     submap_count_ = submap_next_ = 0;
     past_count_ = 0;
+    key_edges_.clear();
   }
 
   /// cur: the newest scan (raw keypoints and descriptors). pair: the frame-to-frame estimate
@@ -112,8 +113,9 @@ class KeyframeTracker {
   const Eigen::Matrix3d& relativePose() const { return rel_T_; }
   const Eigen::Matrix3d& relativeCov() const { return rel_C_; }
   int keyframeSwitches() const { return switches_; }
-  /// EstimatorConfig::keyframe_fusion: extra registrations of new keyframes against earlier
-  /// ones that were fused, and that were refused (chi-square gate) or failed.
+  /// EstimatorConfig::keyframe_fusion and keyframe_graph: extra registrations of new
+  /// keyframes against earlier ones that were used, and that were refused (chi-square gate)
+  /// or failed.
   int fusionsAccepted() const { return fusions_accepted_; }
   int fusionsRejected() const { return fusions_rejected_; }
 
@@ -283,6 +285,12 @@ class KeyframeTracker {
   /// nearest point within kSubmapGate in each earlier keyframe of the ring, then puts the raw
   /// points into the ring. Nothing with submap_keyframes 1.
   void averageWithSubmap(const Eigen::Matrix3d& M_w);
+  /// EstimatorConfig::keyframe_graph (keyframe_graph.cpp): a measured mid-scan pose Z of a
+  /// keyframe relative to the earlier keyframe at stamp `to`, and its [x, y, yaw] covariance.
+  struct GraphEdge {
+    int64_t to = 0;
+    Eigen::Matrix3d Z = Eigen::Matrix3d::Identity(), C = Eigen::Matrix3d::Identity();
+  };
   /// EstimatorConfig::keyframe_fusion (issue 19): the keyframes before the current one, most
   /// recent first (past_[0] is the one before the current keyframe), with what is needed to
   /// register a scan against them again.
@@ -299,7 +307,14 @@ class KeyframeTracker {
     Eigen::Vector3d accel = Eigen::Vector3d::Zero();   ///< key_accel_
     double c = 0.0;                                    ///< key_c_
     int64_t stamp = 0;                                 ///< key_stamp_
+    std::vector<GraphEdge> edges;  ///< keyframe_graph: its edges to earlier keyframes
   };
+  std::vector<GraphEdge> key_edges_, new_edges_;  ///< the current keyframe's, the new one's
+  /// cur becomes the keyframe: registers it against every keyframe of the window (past_ and
+  /// the current one, whose registration T_jk, C_jk is the scan's own) and solves the window's
+  /// poses (information-weighted least squares, the oldest held). M_k, P_m as fuseWithPast.
+  bool solveGraph(const FeatureFrame& cur, double c, const Eigen::Matrix3d& T_jk,
+                  const Eigen::Matrix3d& C_jk, Eigen::Matrix3d& M_k, Eigen::Matrix3d& P_m);
   std::vector<PastKeyframe> past_;
   size_t past_count_ = 0;
   /// [x, y, yaw] covariance of the current keyframe's mid-scan pose relative to the keyframe
@@ -319,10 +334,11 @@ class KeyframeTracker {
                     const Eigen::Matrix3d& C_jk, Eigen::Matrix3d& M_k, Eigen::Matrix3d& P_m);
   /// Registers cur against pk (swapped in as the keyframe) from the prediction T_pred (cur's
   /// mid-scan pose relative to pk's) with covariance C_pred: T (relative) and C ([x, y, yaw],
-  /// the prior left out). False when the registration fails.
+  /// the prior left out). False when the registration fails. graph: weak descriptor
+  /// registrations (kMinWeakInliers) and the proximity ICP count too (keyframe_graph.cpp).
   bool registerToPast(const FeatureFrame& cur, PastKeyframe& pk, double c,
                       const Eigen::Matrix3d& T_pred, const Eigen::Matrix3d& C_pred,
-                      Eigen::Matrix3d& T, Eigen::Matrix3d& C);
+                      Eigen::Matrix3d& T, Eigen::Matrix3d& C, bool graph = false);
   void swapKeyframe(PastKeyframe& pk);
 };
 
