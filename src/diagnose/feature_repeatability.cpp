@@ -138,6 +138,16 @@ Repeatability RepeatabilityMeter::result() const {
   return r;
 }
 
+double trueShareBeyond(const GapFigures& g, size_t edge) {
+  if (edge + 1 >= g.band_true.size())
+    throw std::out_of_range("trueShareBeyond: edge " + std::to_string(edge) + " of " +
+                            std::to_string(g.band_true.size()) + " bands");
+  double all = 0, far = 0;
+  for (size_t b = 0; b < g.band_true.size(); ++b) (b > edge ? far : all) += g.band_true[b];
+  all += far;
+  return all > 0 ? far / all : 0.0;
+}
+
 std::string repeatabilityTable(const Repeatability& r, const RepeatabilityOptions& o) {
   std::string s;
   char buf[256];
@@ -145,13 +155,16 @@ std::string repeatabilityTable(const Repeatability& r, const RepeatabilityOption
                 r.keypoints, r.feature_ms);
   s += buf;
   s += "| gap | repeatable | matches | true | weak (< " + std::to_string(o.weak_inliers) +
-       " true) | true by band |\n|---|---|---|---|---|---|\n";
+       " true) | true by band | true beyond each edge (%) |\n|---|---|---|---|---|---|---|\n";
   for (size_t g = 0; g < r.gaps.size(); ++g) {
     const GapFigures& x = r.gaps[g];
     std::snprintf(buf, sizeof buf, "| %zu | %.0f | %.0f | %.0f | %.0f %% |", g + 1, x.repeatable, x.matches,
                   x.true_matches, 100.0 * x.weak_share);
     s += buf;
     for (double v : x.band_true) std::snprintf(buf, sizeof buf, " %.1f", v), s += buf;
+    s += " |";
+    for (size_t e = 0; e + 1 < x.band_true.size(); ++e)
+      std::snprintf(buf, sizeof buf, " %.0f", 100.0 * trueShareBeyond(x, e)), s += buf;
     s += " |\n";
   }
   s += "\nrange bands (m):";

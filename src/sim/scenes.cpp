@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "city_facades.hpp"
 #include "render_model.hpp"
 
 namespace spinradar::sim {
@@ -141,6 +142,9 @@ class Route {
 
 // ---- city ---------------------------------------------------------------------------------
 
+constexpr int kCityGrid = 6;         ///< blocks per side
+constexpr double kCityPitch = 64.0;  ///< m, street centre line to centre line
+
 Scene city(uint64_t variant, double t0) {
   Scene sc;
   sc.name = "city";
@@ -148,8 +152,8 @@ Scene city(uint64_t variant, double t0) {
       "7x7 street grid (64 m pitch, 14 m streets) with facades, poles, parked and moving cars; "
       "a ~5 min route with 12 turns at 5 m/s and straights at 10-15 m/s";
   Rng rng(0xC1770000ull + variant);
-  const int G = 6;
-  const double P = 64.0, half_street = 7.0;
+  const int G = kCityGrid;
+  const double P = kCityPitch, half_street = 7.0;
   World& w = sc.world;
   // Buildings: each block split into 1-3 buildings along a random axis, with setbacks.
   for (int i = 0; i < G; ++i)
@@ -364,10 +368,20 @@ Scene tightTurns(uint64_t variant, double t0) {
 
 }  // namespace
 
-std::vector<std::string> builtinSceneNames() { return {"city", "out_and_back", "tight_turns"}; }
+std::vector<std::string> builtinSceneNames() {
+  return {"city", "city_facades", "out_and_back", "tight_turns"};
+}
 
 Scene builtinScene(const std::string& name, uint64_t variant, double t0) {
   if (name == "city") return city(variant, t0);
+  if (name == "city_facades") {  // the city + far structure (city_facades.hpp)
+    Scene sc = city(variant, t0);
+    sc.name = name;
+    sc.description += "; facade detail (window bays, doors, balconies, corners) and street "
+                      "furniture as point scatterers";
+    detail::addFacadeDetail(sc.world, variant, kCityGrid, kCityPitch);
+    return sc;
+  }
   if (name == "out_and_back") return outAndBack(variant, t0);
   if (name == "tight_turns") return tightTurns(variant, t0);
   std::string list;

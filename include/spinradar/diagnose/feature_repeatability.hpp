@@ -57,7 +57,14 @@ class RepeatabilityMeter {
   Impl* impl_;
 };
 
-/// The figures as a markdown table (one row per gap) plus the range-band line.
+/// Share (0..1) of a gap's true matches that lie beyond range band edge `edge` (bands after
+/// band_edges[edge]; edge 2 of 2.5,10,25,50,100 = beyond 25 m): the far-structure realism figure
+/// (docs/city_scene_far_structure.md). 0 without true matches; throws std::out_of_range for an
+/// edge past the bands.
+double trueShareBeyond(const GapFigures& g, size_t edge);
+
+/// The figures as a markdown table (one row per gap, with the true-match share beyond each band
+/// edge) plus the range-band line.
 std::string repeatabilityTable(const Repeatability& r, const RepeatabilityOptions& options);
 
 }  // namespace spinradar::diagnose

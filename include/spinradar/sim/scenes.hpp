@@ -3,6 +3,9 @@
 // be written by hand to get started.
 //   "city"         grid of blocks with facades, poles, parked and moving cars; a ~3 min route
 //                  with turns at intersections and speeds up to 15 m/s
+//   "city_facades" the same city (scatterer for scatterer, same route) plus facade detail and
+//                  street furniture: point scatterers that stay bright at grazing incidence,
+//                  the far structure of real streets (docs/city_scene_far_structure.md)
 //   "out_and_back" a straight 1 km road with roadside structures, driven out at 10-20 m/s,
 //                  U-turn, and back on the other lane
 //   "tight_turns"  an open yard with poles, containers and walls; slalom and tight loops

@@ -1,0 +1,47 @@
+#pragma once
+// Facade detail and street furniture of the "city_facades" scene (docs/city_scene_far_structure.md):
+// point-like strong scatterers on and just in front of the city's building walls, and along the
+// kerbs, that stay bright at grazing incidence (a smooth wall returns cos^n of it) and hence far
+// down a street, as window frames, doors, drainpipes, balconies, signs and railings do on a real
+// street. Added on top of the "city" world with its own random stream: the rest of the scene is
+// the same scatterer for scatterer, and "city" itself is untouched.
+#include <cstdint>
+
+#include "spinradar/sim/scene.hpp"
+
+namespace spinradar::sim::detail {
+
+/// Every number of the facade detail, in one place (documented in
+/// docs/city_scene_far_structure.md, where the strengths are argued).
+struct FacadeDetail {
+  double min_wall_m = 6.0;         ///< walls shorter than this are cars, not buildings
+  double bay_min_m = 2.5;          ///< spacing of details along a facade (window bays, doors,
+  double bay_max_m = 5.0;          ///<   drainpipes): uniform in [min, max]
+  double depth_min_m = 0.15;       ///< in front of the wall plane (reveals, sills, frames,
+  double depth_max_m = 0.6;        ///<   drainpipes; balconies further, see balcony_*)
+  double rcs_mean_db = 3.0;        ///< dBsm per detail: normal(mean, sd), clamped to [lo, hi]
+  double rcs_sd_db = 5.0;
+  double rcs_lo_db = -10.0;
+  double rcs_hi_db = 15.0;
+  double balcony_share = 0.15;     ///< share of details that are balconies / railings:
+  double balcony_depth_m = 1.2;    ///<   further out and stronger (metal rails)
+  double balcony_extra_db = 4.0;
+  double corner_rcs_min_db = 5.0;  ///< each building corner (quoins, drainpipes): uniform
+  double corner_rcs_max_db = 15.0;
+  double furniture_min_m = 8.0;    ///< street furniture along each kerb (signs, bollards, bins,
+  double furniture_max_m = 20.0;   ///<   bike racks, railings): spacing uniform in [min, max]
+  double furniture_off_min_m = 5.2;  ///< from the street's centre line (kerb 4.5-7 m)
+  double furniture_off_max_m = 6.4;
+  double furniture_rcs_min_db = -5.0;  ///< dBsm, uniform
+  double furniture_rcs_max_db = 12.0;
+};
+
+/// Adds the facade detail to `w` (the city world of `grid` x `grid` blocks of `pitch` m): details
+/// in front of every building wall (walls of at least min_wall_m; the city's boxes are drawn
+/// counter-clockwise, so the outward normal of wall (x1,y1)->(x2,y2) is (dy, -dx)), a scatterer
+/// at each building corner, and street furniture along every street, junctions kept clear.
+/// Deterministic in `variant`.
+void addFacadeDetail(World& w, uint64_t variant, int grid, double pitch,
+                     const FacadeDetail& p = FacadeDetail{});
+
+}  // namespace spinradar::sim::detail
