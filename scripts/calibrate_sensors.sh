@@ -5,6 +5,8 @@
 # Usage: scripts/calibrate_sensors.sh OUT [REALDATA]   (REALDATA defaults to ../shared/realdata)
 # Needs the built CLI (scripts/cli_path.sh); about 20 minutes on one core, most of it Boreas-RT
 # (6848 bins). Each sample's report: OUT/<sample>/appearance/appearance.md.
+# Env: APPEARANCE_SCENE (the reference world of the fit, default city; city_facades: the city
+# with the far structure of real streets, docs/city_scene_far_structure.md).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="${1:?usage: scripts/calibrate_sensors.sh OUT [REALDATA]}"
@@ -17,7 +19,7 @@ mkdir -p "$out"
 run() {  # name, diagnose arguments...
   local name="$1"; shift
   echo "== $name" >&2
-  "$cli" diagnose "$@" --out "$out/$name" > "$out/$name.log" 2>&1 \
+  "$cli" diagnose "$@" --appearance-scene "${APPEARANCE_SCENE:-city}" --out "$out/$name" > "$out/$name.log" 2>&1 \
     || { echo "$name: diagnose failed, see $out/$name.log" >&2; exit 1; }
   local fitted="$out/$name/appearance/sensor_fitted.json"
   cp "$fitted" "$root/config/sensors/$name.json.tmp"

@@ -21,7 +21,9 @@
 #      THREADS (default 2), COLS / ROWS (space-separated labels to restrict to), SEED (1),
 #      STEP (devkit first-frame step, default 4), SHARED (default ../shared next to the repo),
 #      MERGE (further results.tsv files, e.g. of a run on other COLS, to print in the tables),
-#      TABLE_ONLY=1 (print the tables of OUT_DIR/results.tsv and MERGE, run nothing).
+#      TABLE_ONLY=1 (print the tables of OUT_DIR/results.tsv and MERGE, run nothing),
+#      CITY_SCENE (the built-in scene of every city_* column, default city; city_facades adds
+#      the far structure of real streets, docs/city_scene_far_structure.md).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="${1:-$root/build/evaluation_matrix}"
@@ -30,6 +32,7 @@ threads="${THREADS:-2}"
 seed="${SEED:-1}"
 step="${STEP:-4}"
 shared="${SHARED:-$root/../shared}"
+city="${CITY_SCENE:-city}"
 [[ -d "$shared/realdata" ]] || shared="/work/shared"
 
 source "$root/scripts/cli_path.sh"
@@ -64,24 +67,24 @@ done
 
 # --- columns: label | scene | variant | sensor JSON | clutter factor | held out ------------
 cols_spec=(
-  "city_wide|city|0|{}|1|no"
-  "city_narrow|city|0|{\"range_psf_sigma_bins\": 0.64}|1|no"
-  "city_beam1.5|city|0|{\"beam_width_deg\": 1.5}|1|no"
-  "city_beam2.4|city|0|{\"beam_width_deg\": 2.4}|1|no"
-  "city_noise14|city|0|{\"noise_floor_db\": 14.0}|1|no"
-  "city_clutter4x|city|0|{}|4|no"
+  "city_wide|$city|0|{}|1|no"
+  "city_narrow|$city|0|{\"range_psf_sigma_bins\": 0.64}|1|no"
+  "city_beam1.5|$city|0|{\"beam_width_deg\": 1.5}|1|no"
+  "city_beam2.4|$city|0|{\"beam_width_deg\": 2.4}|1|no"
+  "city_noise14|$city|0|{\"noise_floor_db\": 14.0}|1|no"
+  "city_clutter4x|$city|0|{}|4|no"
   "tight_turns|tight_turns|0|{}|1|no"
   "out_and_back_v2|out_and_back|2|{}|1|no"
-  "city_v5_narrow_beam2.4|city|5|{\"range_psf_sigma_bins\": 0.64, \"beam_width_deg\": 2.4}|1|yes"
+  "city_v5_narrow_beam2.4|$city|5|{\"range_psf_sigma_bins\": 0.64, \"beam_width_deg\": 2.4}|1|yes"
   "out_and_back|out_and_back|0|{}|1|yes"
   # Glint (physics "glint", m: each scan moves every scattering centre by that much per axis):
   # real returns matched between scans spread 0.15-0.25 m across the beam, the simulator's
   # without glint 0.05-0.07 m (docs/diagnose_glint.md; fitted Oxford 0.09-0.14, RADIATE 0.18).
-  "city_glint0.14|city|0|{}|1|no|\"glint\": 0.14"
+  "city_glint0.14|$city|0|{}|1|no|\"glint\": 0.14"
   # The calibrated files carry the glint terms fitted on the real samples (physics block of
   # config/sensors, eighth round): city_oxford and city_radiate have them; this column keeps
   # the seventh round's isotropic 0.14 m instead, with the file's terms set to 0.
-  "city_oxford_glint0.14|city|0|@oxford|1|no|\"glint\": 0.14, \"glint_across\": 0, \"glint_along\": 0, \"azimuth_jitter\": 0"
+  "city_oxford_glint0.14|$city|0|@oxford|1|no|\"glint\": 0.14, \"glint_across\": 0, \"glint_along\": 0, \"azimuth_jitter\": 0"
   "out_and_back_glint0.18|out_and_back|0|{}|1|yes|\"glint\": 0.18"
 )
 # "@name": the calibrated model config/sensors/name.json.
@@ -95,7 +98,7 @@ for i in "${!cols_spec[@]}"; do
 done
 for f in "$root"/config/sensors/*.json; do
   [[ -f "$f" ]] || continue
-  cols_spec+=("city_$(basename "$f" .json)|city|0|$(tr -d '\n' < "$f")|1|no")
+  cols_spec+=("city_$(basename "$f" .json)|$city|0|$(tr -d '\n' < "$f")|1|no")
 done
 cols_spec+=("oxford_real|-|-|-|-|no")
 # The same 3 real scans as one pair with twice the baseline (scan 1 -> 3, 0.5 s): a third

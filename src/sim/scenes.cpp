@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "city_facades.hpp"
+#include "spinradar/sim/city_facades.hpp"
 #include "render_model.hpp"
 
 namespace spinradar::sim {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "spinradar/sim/city_facades.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
 
@@ -52,14 +53,35 @@ TEST(CityFacades, IsTheCityPlusAppendedTargets) {
       EXPECT_EQ(c.trajectory.samples()[i].pose.yaw, f.trajectory.samples()[i].pose.yaw);
     }
     // The added detail is static, within the documented strengths, and outside every building
-    // (in front of its facade): no added target lies inside a wall's box interior.
+    // (in front of its facade).
+    const detail::FacadeDetail p;
+    const double lo = std::min({p.rcs_lo_db, p.furniture_rcs_min_db, p.corner_rcs_min_db});
+    const double hi = std::max({p.rcs_hi_db + 10 * std::log10(p.floors_max) + p.balcony_extra_db,
+                                p.furniture_rcs_max_db, p.corner_rcs_max_db});
     for (size_t i = c.world.targets.size(); i < f.world.targets.size(); ++i) {
       const Target& t = f.world.targets[i];
       EXPECT_EQ(t.vx, 0.0);
       EXPECT_EQ(t.vy, 0.0);
-      EXPECT_GE(t.rcs, -10.0);
-      EXPECT_LE(t.rcs, 19.0);
+      EXPECT_GE(t.rcs, lo);
+      EXPECT_LE(t.rcs, hi);
     }
+    // Buildings are axis-aligned boxes of four consecutive walls: no detail inside one.
+    int inside = 0;
+    for (size_t b = 0; b + 3 < f.world.walls.size(); b += 4) {
+      const Wall& w0 = f.world.walls[b];
+      if (std::hypot(w0.x2 - w0.x1, w0.y2 - w0.y1) < p.min_wall_m) continue;  // a car
+      double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+      for (size_t k = b; k < b + 4; ++k) {
+        const Wall& wl = f.world.walls[k];
+        x0 = std::min({x0, wl.x1, wl.x2}), x1 = std::max({x1, wl.x1, wl.x2});
+        y0 = std::min({y0, wl.y1, wl.y2}), y1 = std::max({y1, wl.y1, wl.y2});
+      }
+      for (size_t i = c.world.targets.size(); i < f.world.targets.size(); ++i) {
+        const Target& t = f.world.targets[i];
+        inside += t.x > x0 + 0.01 && t.x < x1 - 0.01 && t.y > y0 + 0.01 && t.y < y1 - 0.01;
+      }
+    }
+    EXPECT_EQ(inside, 0) << variant;
   }
   // Different variants lay the detail out differently.
   EXPECT_NE(builtinScene("city_facades", 0).world.targets.back().x,

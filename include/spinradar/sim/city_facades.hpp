@@ -15,17 +15,25 @@ namespace spinradar::sim::detail {
 /// docs/city_scene_far_structure.md, where the strengths are argued).
 struct FacadeDetail {
   double min_wall_m = 6.0;         ///< walls shorter than this are cars, not buildings
-  double bay_min_m = 2.5;          ///< spacing of details along a facade (window bays, doors,
-  double bay_max_m = 5.0;          ///<   drainpipes): uniform in [min, max]
-  double depth_min_m = 0.15;       ///< in front of the wall plane (reveals, sills, frames,
-  double depth_max_m = 0.6;        ///<   drainpipes; balconies further, see balcony_*)
-  double rcs_mean_db = 3.0;        ///< dBsm per detail: normal(mean, sd), clamped to [lo, hi]
-  double rcs_sd_db = 5.0;
-  double rcs_lo_db = -10.0;
-  double rcs_hi_db = 15.0;
-  double balcony_share = 0.15;     ///< share of details that are balconies / railings:
+  int floors_min = 2;              ///< storeys per building, uniform: the sensor's vertical fan
+  int floors_max = 5;              ///<   sees every storey beyond ~20 m, so the details of a bay
+                                   ///<   stacked over F storeys add up: + 10 log10(F) dB
+  double bay_min_m = 2.5;          ///< spacing of window / door bays along a facade: uniform
+  double bay_max_m = 4.5;
+  double opening_min_m = 0.9;      ///< width of an opening; each of its two reveals (frame
+  double opening_max_m = 1.6;      ///<   corners, sills) is one detail
+  double depth_min_m = 0.1;        ///< in front of the wall plane (frames, sills, drainpipes)
+  double depth_max_m = 0.5;
+  double rcs_mean_db = 0.0;        ///< dBsm per detail and storey: normal(mean, sd), clamped
+  double rcs_sd_db = 5.0;          ///<   to [lo, hi]
+  double rcs_lo_db = -12.0;
+  double rcs_hi_db = 12.0;
+  double balcony_share = 0.15;     ///< share of bays with balconies / railings: one more detail
   double balcony_depth_m = 1.2;    ///<   further out and stronger (metal rails)
   double balcony_extra_db = 4.0;
+  double pipe_min_m = 8.0;         ///< drainpipes: spacing uniform in [min, max], 0.15 m out
+  double pipe_max_m = 16.0;
+  double pipe_rcs_db = 3.0;        ///< dBsm per storey (a metal cylinder, ~0.1 m)
   double corner_rcs_min_db = 5.0;  ///< each building corner (quoins, drainpipes): uniform
   double corner_rcs_max_db = 15.0;
   double furniture_min_m = 8.0;    ///< street furniture along each kerb (signs, bollards, bins,
