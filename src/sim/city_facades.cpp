@@ -38,6 +38,8 @@ void addFacadeDetail(World& w, uint64_t variant, int grid, double pitch, const F
     }
     for (double u = uni(1.0, p.pipe_max_m); u < len - 1.0; u += uni(p.pipe_min_m, p.pipe_max_m))
       add(u, 0.15, p.pipe_rcs_db + stack_db);
+    for (double u = uni(0, p.rough_max_m); u < len; u += uni(p.rough_min_m, p.rough_max_m))
+      add(u, uni(0, p.rough_depth_m), p.rough_rcs_mean_db + p.rough_rcs_sd_db * rng.normal() + stack_db);
   }
   // Street furniture along both kerbs of every street (x- and y-streets), junctions clear.
   for (int k = 0; k <= grid; ++k)

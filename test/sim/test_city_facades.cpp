@@ -55,9 +55,11 @@ TEST(CityFacades, IsTheCityPlusAppendedTargets) {
     // The added detail is static, within the documented strengths, and outside every building
     // (in front of its facade).
     const detail::FacadeDetail p;
-    const double lo = std::min({p.rcs_lo_db, p.furniture_rcs_min_db, p.corner_rcs_min_db});
+    const double lo = std::min({p.rcs_lo_db, p.furniture_rcs_min_db, p.corner_rcs_min_db,
+                                p.rough_rcs_mean_db - 8 * p.rough_rcs_sd_db});
     const double hi = std::max({p.rcs_hi_db + 10 * std::log10(p.floors_max) + p.balcony_extra_db,
-                                p.furniture_rcs_max_db, p.corner_rcs_max_db});
+                                p.furniture_rcs_max_db, p.corner_rcs_max_db,
+                                p.rough_rcs_mean_db + 8 * p.rough_rcs_sd_db + 10 * std::log10(p.floors_max)});
     for (size_t i = c.world.targets.size(); i < f.world.targets.size(); ++i) {
       const Target& t = f.world.targets[i];
       EXPECT_EQ(t.vx, 0.0);

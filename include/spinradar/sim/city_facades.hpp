@@ -34,6 +34,11 @@ struct FacadeDetail {
   double pipe_min_m = 8.0;         ///< drainpipes: spacing uniform in [min, max], 0.15 m out
   double pipe_max_m = 16.0;
   double pipe_rcs_db = 3.0;        ///< dBsm per storey (a metal cylinder, ~0.1 m)
+  double rough_min_m = 0.3;        ///< facade roughness (brick, stone, render, ledges, sills of
+  double rough_max_m = 0.7;        ///<   the storeys above): weak scatterers along every wall,
+  double rough_depth_m = 0.3;      ///<   spacing uniform in [min, max], 0..depth out; diffuse,
+  double rough_rcs_mean_db = -12.0;  ///< so the same at any incidence: dBsm per scatterer and
+  double rough_rcs_sd_db = 5.0;      ///<   storey, normal(mean, sd)
   double corner_rcs_min_db = 5.0;  ///< each building corner (quoins, drainpipes): uniform
   double corner_rcs_max_db = 15.0;
   double furniture_min_m = 8.0;    ///< street furniture along each kerb (signs, bollards, bins,
@@ -45,7 +50,7 @@ struct FacadeDetail {
 };
 
 /// Adds the facade detail to `w` (the city world of `grid` x `grid` blocks of `pitch` m): details
-/// in front of every building wall (walls of at least min_wall_m; the city's boxes are drawn
+/// and roughness in front of every building wall (walls of at least min_wall_m; the city's boxes are drawn
 /// counter-clockwise, so the outward normal of wall (x1,y1)->(x2,y2) is (dy, -dx)), a scatterer
 /// at each building corner, and street furniture along every street, junctions kept clear.
 /// Deterministic in `variant`.
