@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <stdexcept>
 
 #include "spinradar/diagnose/feature_repeatability.hpp"
 #include "spinradar/sim/scenes.hpp"
@@ -78,4 +79,19 @@ TEST(FeatureRepeatability, RejectsBadOptions) {
   o = {};
   o.band_edges = {10.0, 5.0};
   EXPECT_THROW(o.validate(), std::invalid_argument);
+}
+
+// The far-structure realism figure (docs/city_scene_far_structure.md), on the real Oxford
+// sample's true matches one scan apart per band (< 2.5, 2.5-10, 10-25, 25-50, 50-100, > 100 m):
+// 42.5 of 63.5 lie beyond 25 m, 18.5 beyond 50 m.
+TEST(FeatureRepeatability, TrueShareBeyondABandEdge) {
+  diagnose::GapFigures g;
+  g.band_true = {0.0, 2.0, 19.0, 24.0, 18.5, 0.0};
+  EXPECT_DOUBLE_EQ(diagnose::trueShareBeyond(g, 0), 1.0);
+  EXPECT_DOUBLE_EQ(diagnose::trueShareBeyond(g, 2), 42.5 / 63.5);
+  EXPECT_DOUBLE_EQ(diagnose::trueShareBeyond(g, 3), 18.5 / 63.5);
+  EXPECT_DOUBLE_EQ(diagnose::trueShareBeyond(g, 4), 0.0);
+  EXPECT_THROW(diagnose::trueShareBeyond(g, 5), std::out_of_range);
+  g.band_true.assign(6, 0.0);
+  EXPECT_DOUBLE_EQ(diagnose::trueShareBeyond(g, 2), 0.0);  // no true match: no share
 }
