@@ -24,20 +24,18 @@
 
 #include "spinradar/core/lie.hpp"
 #include "spinradar/estimation/keyframe_tracker.hpp"
+#include "spinradar/estimation/pose_graph.hpp"
 
 namespace spinradar {
 
 namespace {
 
-constexpr int kGraphIterations = 5;
 /// The extra registrations' covariances are taken this many times over: against keyframes
 /// up to keyframe_graph switches back their errors are not all independent of the chain's
 /// (the same map points, the same undistortion), and weighed as given they pulled the narrow
 /// and dense-clutter columns off (keyframe_graph 6, 1 -> 2: city_oxford 0.237 -> 0.210 %,
 /// city_mulran 0.168 -> 0.152; 4 lost city_oxford_glint0.14 0.42 -> 0.53).
 constexpr double kGraphEdgeInflation = 2.0;
-
-double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
 }  // namespace
 
@@ -91,58 +89,46 @@ bool KeyframeTracker::solveGraph(const FeatureFrame& cur, double c, const Eigen:
   stamp[n - 1] = cur.stamp_ns;
   x[n - 1] = se2::toXyYaw(M_j * T_jk);
   edges[n - 1] = &new_edges_;
-  // Gauss-Newton over the free nodes 1..n-1 (node 0 held): residual of an edge a -> b,
-  // r = [R(-yaw_a) (t_b - t_a) - z_t; yaw_b - yaw_a - z_yaw], weighted by C^-1.
-  const int m = 3 * (n - 1);
-  Eigen::MatrixXd H(m, m);
-  Eigen::VectorXd g(m);
-  bool ok = false;
-  for (int it = 0; it < kGraphIterations; ++it) {
-    H.setZero();
-    g.setZero();
-    for (int b = 1; b < n; ++b) {
-      for (const GraphEdge& e : *edges[b]) {
-        int a = -1;
-        for (int q = 0; q < b; ++q)
-          if (stamp[q] == e.to) a = q;
-        if (a < 0) continue;  // to a keyframe that left the window
-        const double ca = std::cos(x[a](2)), sa = std::sin(x[a](2));
-        Eigen::Matrix2d Ri;
-        Ri << ca, sa, -sa, ca;
-        const Eigen::Vector2d d = Ri * (x[b].head<2>() - x[a].head<2>());
-        const Eigen::Vector3d z = se2::toXyYaw(e.Z);
-        Eigen::Vector3d r;
-        r << d - z.head<2>(), wrap(x[b](2) - x[a](2) - z(2));
-        Eigen::Matrix3d Jb = Eigen::Matrix3d::Zero(), Ja = Eigen::Matrix3d::Zero();
-        Jb.topLeftCorner<2, 2>() = Ri;
-        Jb(2, 2) = 1.0;
-        Ja.topLeftCorner<2, 2>() = -Ri;
-        Ja(0, 2) = d.y();
-        Ja(1, 2) = -d.x();
-        Ja(2, 2) = -1.0;
-        const Eigen::Matrix3d W = e.C.ldlt().solve(Eigen::Matrix3d::Identity());
-        const int ib = 3 * (b - 1), ia = 3 * (a - 1);
-        H.block<3, 3>(ib, ib) += Jb.transpose() * W * Jb;
-        g.segment<3>(ib) += Jb.transpose() * W * r;
-        if (a > 0) {
-          H.block<3, 3>(ia, ia) += Ja.transpose() * W * Ja;
-          H.block<3, 3>(ia, ib) += Ja.transpose() * W * Jb;
-          H.block<3, 3>(ib, ia) += Jb.transpose() * W * Ja;
-          g.segment<3>(ia) += Ja.transpose() * W * r;
-        }
+  std::vector<PoseGraphEdge> pg;
+  std::vector<int> candidates, new_index;  // the new keyframe's extra edges
+  for (int b = 1; b < n; ++b) {
+    for (size_t k = 0; k < edges[b]->size(); ++k) {
+      const GraphEdge& e = (*edges[b])[k];
+      int a = -1;
+      for (int q = 0; q < b; ++q)
+        if (stamp[q] == e.to) a = q;
+      if (a < 0) continue;  // to a keyframe that left the window
+      if (b == n - 1 && k > 0) {
+        candidates.push_back(static_cast<int>(pg.size()));
+        new_index.push_back(static_cast<int>(k));
       }
+      pg.push_back(PoseGraphEdge{a, b, se2::toXyYaw(e.Z), e.C});
     }
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
-    if (ldlt.info() != Eigen::Success) return false;
-    const Eigen::VectorXd dx = -ldlt.solve(g);
-    if (!dx.allFinite()) return false;
-    for (int k = 1; k < n; ++k) x[k] += dx.segment<3>(3 * (k - 1));
-    ok = true;
-    if (dx.cwiseAbs().maxCoeff() < 1e-9) break;
   }
-  if (!ok) return false;
+  // keyframe_graph_screen: each extra edge of the new keyframe against the window without it
+  // (pose_graph.cpp); an edge the rest of the window contradicts (chi-square, 99 %, 3 dof) is
+  // dropped, the worst first, and not kept for later windows. Off: on the turn entry it was
+  // meant for the edges agree within their covariances (round11 doc), and it lost the glint gain.
+  std::vector<bool> skip;
+  const int dropped =
+      config_.keyframe_graph_screen ? screenEdges(x, pg, candidates, kFusionChi2, skip) : 0;
+  if (dropped > 0) {
+    std::vector<GraphEdge> kept;
+    for (size_t k = 0; k < new_edges_.size(); ++k) {
+      bool drop = false;
+      for (size_t q = 0; q < candidates.size(); ++q)
+        if (new_index[q] == static_cast<int>(k) && skip[candidates[q]]) drop = true;
+      if (!drop) kept.push_back(new_edges_[k]);
+    }
+    new_edges_.swap(kept);
+    graph_edges_dropped_ += dropped;
+    fusions_accepted_ -= dropped;
+    fusions_rejected_ += dropped;
+    if (new_edges_.size() < 2) return false;
+  }
+  Eigen::MatrixXd Sigma;
+  if (!solvePoseGraph(x, pg, skip, &Sigma)) return false;
   // The new node's covariance relative to the held node (world axes -> the held node's).
-  const Eigen::MatrixXd Sigma = H.ldlt().solve(Eigen::MatrixXd::Identity(m, m));
   Eigen::Matrix3d G = Eigen::Matrix3d::Identity();
   const double c0 = std::cos(x[0](2)), s0 = std::sin(x[0](2));
   G.topLeftCorner<2, 2>() << c0, s0, -s0, c0;

@@ -118,6 +118,8 @@ class KeyframeTracker {
   /// or failed.
   int fusionsAccepted() const { return fusions_accepted_; }
   int fusionsRejected() const { return fusions_rejected_; }
+  /// keyframe_graph: extra edges dropped by the leave-one-out screen (also in fusionsRejected).
+  int graphEdgesDropped() const { return graph_edges_dropped_; }
 
   static constexpr double kKeyframeDistance = 10.0;  ///< m, new keyframe beyond this
   static constexpr double kKeyframeAngle = 0.35;     ///< rad
@@ -320,7 +322,7 @@ class KeyframeTracker {
   /// [x, y, yaw] covariance of the current keyframe's mid-scan pose relative to the keyframe
   /// before it (the registration that made it, cov_acc with its model errors).
   Eigen::Matrix3d key_rel_cov_ = Eigen::Matrix3d::Zero();
-  int fusions_accepted_ = 0, fusions_rejected_ = 0;
+  int fusions_accepted_ = 0, fusions_rejected_ = 0, graph_edges_dropped_ = 0;
   double nndr_ = 0.8;  ///< track()'s ratio test, for the extra registrations
   /// The current scan's velocity prior and its covariances (track()), for the extra ones.
   Eigen::Vector3d fuse_xi_prior_ = Eigen::Vector3d::Zero();
