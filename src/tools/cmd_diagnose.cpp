@@ -33,7 +33,7 @@ struct DiagnoseArgs {
   bool no_resimulate = false, appearance = false;
   std::string sensor;  // base sensor model of the appearance stage (file or calibrated name)
   int appearance_scans = 4;
-  int curve_iterations = 16, curve_starts = 1;
+  int curve_iterations = 16, curve_starts = 3;
   std::vector<double> curve_start_offset;  // noise dB, returns dB, log2 density (measurement)
   bool no_holdout = false;
   bool fit_floor = false;
@@ -329,7 +329,7 @@ SPINRADAR_COMMAND(
       app.add_option("--appearance-curve-iterations", a->curve_iterations,
                      "Steps of the per-band calibration (range curves; 0 = off)");
       app.add_option("--appearance-curve-starts", a->curve_starts, "Starts of the per-band "
-                     "calibration (1-6; a full run from each, the best fit-part misfit wins)")->check(CLI::Range(1, 6));
+                     "calibration (1-6; a full run from each, the best fit-part misfit wins; default 3)")->check(CLI::Range(1, 6));
       app.add_option("--appearance-curve-start-offset", a->curve_start_offset, "Move its start: "
                      "noise dB, returns dB, log2 clutter density")->expected(3)->check(CLI::Range(-20.0, 20.0));
       app.add_flag("--appearance-no-holdout", a->no_holdout,
