@@ -115,36 +115,5 @@ TEST(AppearanceMultiStart, NullFromFarStartNamesNothing) {
   expectHiddenCurves(multi, 0.0, "null", true);
 }
 
-TEST(AppearanceMultiStart, Explore) {
-  if (!std::getenv("SPINRADAR_EXPLORE")) GTEST_SKIP();
-  AppearanceOptions opt = testing::quickAppearanceOptions();
-  opt.curve_iterations = std::atoi(std::getenv("SPINRADAR_EXPLORE"));
-  opt.fit_band_floor = true;
-  for (const double hidden : {6.0, 0.0}) {
-    sim::SensorConfig truth = baseSensor();
-    truth.stc_curve_db_71m = hidden;
-    truth.return_gain_db_71m = -hidden;
-    const auto real = sim::computeRealism(renderReference(truth, {}, opt, 4244), "recording");
-    for (const Start st : {Start{0, 0, 0}, Start{-12, 0, 0}, Start{-8, 8, 0}, Start{6, -6, 1},
-                           Start{0, 0, 3}, Start{-6, 0, -3}}) {
-      for (int starts : {1, 3}) {
-        opt.curve_starts = starts;
-        const auto s0 = perturbCurveStart(baseSensor(), st.noise, st.returns, st.density);
-        std::vector<std::string> log;
-        const auto f = fitRangeCurves(real, s0, {}, opt, &log);
-        const auto after = realismOf(f, {}, opt, opt.seed, "after");
-        double w = 0;
-        for (const auto& [n, g] : fittedBandGaps(after, real)) w = std::max(w, g);
-        std::cerr << "hidden " << hidden << " start " << st.noise << "," << st.returns << ","
-                  << st.density << " starts " << starts << ": stc71 " << f.stc_curve_db_71m
-                  << " stc35 " << f.stc_curve_db_35m << " stc16 " << f.stc_curve_db_16m
-                  << " ret71 " << f.stc_curve_db_71m + f.return_gain_db_71m << " cx71 "
-                  << f.clutter_density_x_71m << " cx35 " << f.clutter_density_x_35m
-                  << " worst " << w << " | " << (log.empty() ? "" : log.back()) << "\n";
-      }
-    }
-  }
-}
-
 }  // namespace
 }  // namespace spinradar::diagnose
