@@ -24,18 +24,17 @@ namespace fs = std::filesystem;
 using namespace spinradar;
 
 struct DiagnoseArgs {
-  std::string recording, trajectory, world, base, out, map_split = "auto";
-  std::string format = "oxford";
+  std::string recording, trajectory, world, base, out, map_split = "auto", format = "oxford";
   bool timing_only = false;
   double range_resolution = 0;  // 0: sensor.json or the default
   int first_scan = 0, max_scans = -1;
   double alpha = 0.001;
   uint64_t seed = 97;
-  bool no_resimulate = false;
-  bool appearance = false;
+  bool no_resimulate = false, appearance = false;
   std::string sensor;  // base sensor model of the appearance stage (file or calibrated name)
   int appearance_scans = 4;
-  int curve_iterations = 16;
+  int curve_iterations = 16, curve_starts = 3;
+  std::vector<double> curve_start_offset;  // noise dB, returns dB, log2 density (measurement)
   bool no_holdout = false;
   bool fit_floor = false;
   bool fit_zeros = false;
@@ -82,6 +81,8 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   diagnose::AppearanceOptions opt;
   opt.scans = a.appearance_scans;
   opt.curve_iterations = a.curve_iterations;
+  opt.curve_starts = a.curve_starts;
+  for (size_t i = 0; i < a.curve_start_offset.size() && i < 3; ++i) opt.curve_start_offset[i] = a.curve_start_offset[i];
   opt.holdout = !a.no_holdout;
   opt.fit_band_floor = a.fit_floor;
   opt.fit_band_zeros = a.fit_zeros;
@@ -327,6 +328,10 @@ SPINRADAR_COMMAND(
                      "(oxford, mulran, boreas_rt, radiate); default: the CIR204-H defaults");
       app.add_option("--appearance-curve-iterations", a->curve_iterations,
                      "Steps of the per-band calibration (range curves; 0 = off)");
+      app.add_option("--appearance-curve-starts", a->curve_starts, "Starts of the per-band "
+                     "calibration (1-6; a full run from each, the best fit-part misfit wins; default 3)")->check(CLI::Range(1, 6));
+      app.add_option("--appearance-curve-start-offset", a->curve_start_offset, "Move its start: "
+                     "noise dB, returns dB, log2 clutter density")->expected(3)->check(CLI::Range(-20.0, 20.0));
       app.add_flag("--appearance-no-holdout", a->no_holdout,
                    "Fit the appearance on the whole recording (default: fit on the first half of "
                    "the scans, or quarters 0 and 2 of a single scan, check on the rest)");

@@ -132,6 +132,14 @@ struct AppearanceOptions {
   /// Per-band calibration after the global fit: range curves fitted on the per-band realism
   /// figures (fitRangeCurves); 0 iterations = off.
   int curve_iterations = 24;
+  /// Starts of the range-curve fit (1-6): the given start, flat curves, flat curves with fixed
+  /// offsets of the noise level, the returns' level and the clutter density; a full run from
+  /// each, the lowest misfit on the fit part wins (fitRangeCurves). 1 = the single
+  /// Levenberg-Marquardt run.
+  int curve_starts = 1;
+  /// Move the range-curve fit's start before it runs (perturbCurveStart: noise dB, returns dB,
+  /// log2 clutter density): to measure how the fit depends on where it starts.
+  std::array<double, 3> curve_start_offset{};
   /// Add each band's floor (mean of the lower half of the counts) to the range-curve fit's
   /// figures, so that receiver noise and dense weak clutter are told apart. Off by default: on
   /// the Oxford sample it gives the recording's noise floor back (50-100 m: 2.1 counts, the
@@ -304,6 +312,12 @@ sim::RealismStats realismOf(const sim::SensorConfig& sensor, const sim::PhysicsC
 sim::SensorConfig fitRangeCurves(const sim::RealismStats& real, const sim::SensorConfig& start,
                                  const sim::PhysicsConfig& physics, const AppearanceOptions& opt,
                                  std::vector<std::string>* log = nullptr);
+
+/// `start` with every range node moved: noise level (receiver gain curve) by `noise_db`, the
+/// returns' level by `returns_db` (dB), the clutter density by 2^`log2_density`, within the
+/// nodes' bounds. The starts of the multi-start fit, and the perturbed starts of its tests.
+sim::SensorConfig perturbCurveStart(const sim::SensorConfig& start, double noise_db,
+                                    double returns_db, double log2_density);
 
 /// Writes appearance.json, appearance.md, sensor_fitted.json, physics_fitted.json and PNG
 /// plots (band profiles before/after, intensity histograms) into out_dir.
