@@ -3,7 +3,7 @@
 # with the appearance stage of `spinradar diagnose` on the real samples, and prints the README /
 # docs/diagnose.md before/after table (scripts/appearance_table.py).
 # Usage: scripts/calibrate_sensors.sh OUT [REALDATA]   (REALDATA defaults to ../shared/realdata)
-# Needs the built CLI (scripts/cli_path.sh); about 20 minutes on one core, most of it Boreas-RT
+# Needs the built CLI (scripts/cli_path.sh); about 20 minutes on one core with one start of the range curves (several times that with the default 3, --appearance-curve-starts), most of it Boreas-RT
 # (6848 bins). Each sample's report: OUT/<sample>/appearance/appearance.md.
 # Env: APPEARANCE_SCENE (the reference world of the fit, default city; city_facades: the city
 # with the far structure of real streets, docs/city_scene_far_structure.md).
