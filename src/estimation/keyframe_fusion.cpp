@@ -141,24 +141,30 @@ bool KeyframeTracker::registerToPast(const FeatureFrame& cur, PastKeyframe& pk, 
   return ok;
 }
 
+void KeyframeTracker::predictAgainstPast(size_t i, const Eigen::Matrix3d& T_jk,
+                                         const Eigen::Matrix3d& C_jk, Eigen::Matrix3d& X,
+                                         Eigen::Matrix3d& C) const {
+  if (i == 0) {
+    const Eigen::Matrix3d M_j = T_wj_ * se2::exp(key_c_ * key_xi_);
+    se2::compoundXyYaw(se2::inverse(past_[0].M_w) * M_j, key_rel_cov_, T_jk, C_jk, X, C);
+    return;
+  }
+  Eigen::Matrix3d X_i, C_i;  // relative to past_[i] instead, through past_[i - 1]
+  se2::compoundXyYaw(se2::inverse(past_[i].M_w) * past_[i - 1].M_w, past_[i - 1].C_rel, X, C,
+                     X_i, C_i);
+  X = X_i;
+  C = C_i;
+}
+
 bool KeyframeTracker::fuseWithPast(const FeatureFrame& cur, double c, const Eigen::Matrix3d& T_jk,
                                    const Eigen::Matrix3d& C_jk, Eigen::Matrix3d& M_k,
                                    Eigen::Matrix3d& P_m) {
   if (past_count_ == 0) return false;
-  const Eigen::Matrix3d M_j = T_wj_ * se2::exp(key_c_ * key_xi_);
-  // The chained estimate of M_k relative to past_[0] and its covariance.
-  Eigen::Matrix3d X, C;
-  se2::compoundXyYaw(se2::inverse(past_[0].M_w) * M_j, key_rel_cov_, T_jk, C_jk, X, C);
+  Eigen::Matrix3d X, C;  // the chained estimate of M_k relative to past_[i], its covariance
   int fused_at = -1;
   Eigen::Matrix3d X_fused, C_fused;
   for (size_t i = 0; i < past_count_; ++i) {
-    if (i > 0) {  // relative to past_[i] instead, through past_[i - 1]
-      Eigen::Matrix3d X_i, C_i;
-      se2::compoundXyYaw(se2::inverse(past_[i].M_w) * past_[i - 1].M_w, past_[i - 1].C_rel, X, C,
-                         X_i, C_i);
-      X = X_i;
-      C = C_i;
-    }
+    predictAgainstPast(i, T_jk, C_jk, X, C);
     Eigen::Matrix3d T_b, C_b;
     if (!registerToPast(cur, past_[i], c, X, C, T_b, C_b)) {
       ++fusions_rejected_;

@@ -46,15 +46,8 @@ bool KeyframeTracker::solveGraph(const FeatureFrame& cur, double c, const Eigen:
   const Eigen::Matrix3d M_j = T_wj_ * se2::exp(key_c_ * key_xi_);
   // Extra registrations against past_[i], predicted along the chain (as fuseWithPast).
   Eigen::Matrix3d X, C;
-  se2::compoundXyYaw(se2::inverse(past_[0].M_w) * M_j, key_rel_cov_, T_jk, C_jk, X, C);
   for (size_t i = 0; i < past_count_; ++i) {
-    if (i > 0) {
-      Eigen::Matrix3d X_i, C_i;
-      se2::compoundXyYaw(se2::inverse(past_[i].M_w) * past_[i - 1].M_w, past_[i - 1].C_rel, X, C,
-                         X_i, C_i);
-      X = X_i;
-      C = C_i;
-    }
+    predictAgainstPast(i, T_jk, C_jk, X, C);
     Eigen::Matrix3d T_b, C_b;
     if (!registerToPast(cur, past_[i], c, X, C, T_b, C_b, true)) {
       ++fusions_rejected_;

@@ -11,72 +11,20 @@
 #include <cmath>
 #include <iostream>
 
-#include <Eigen/Cholesky>
-
-#include "support/noisy_prior.hpp"
-#include "support/glint_scene.hpp"
-#include "support/synthetic_scene.hpp"
-#include "spinradar/core/lie.hpp"
-#include "spinradar/estimation/keyframe_tracker.hpp"
+#include "support/glint_drive.hpp"
 
 using namespace spinradar;
-using spinradar::testing::NoisyPrior;
-using spinradar::testing::SceneOptions;
-using spinradar::testing::SyntheticScene;
 
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-struct Drive {
-  double heading_rms = 0.0;  ///< rad, accumulated heading error over the drive
-  double key_heading_rms = 0.0;  ///< rad, the same at the scans that became keyframes
-  double nees = 0.0;         ///< mean e^T P^-1 e over [x, y, yaw] (honest: ~3)
-  double heading_nees = 0.0;  ///< mean e_yaw^2 / P_yaw (honest: ~1)
-  int switches = 0, fused = 0, refused = 0;
-};
+using Drive = spinradar::testing::GlintDrive;
 
-Drive drive(uint32_t seed, double glint, int graph, int scans = 120) {
-  const SceneOptions o = spinradar::testing::glintSceneOptions(seed, glint);
-  const Eigen::Vector3d v(6.0, 0.0, 0.15);
-  SyntheticScene scene(o, {v});
+Drive drive(uint32_t seed, double glint, int graph) {
   EstimatorConfig cfg;
-  cfg.beta = 0.0;
   cfg.keyframe_graph = graph;
-  KeyframeTracker kt(cfg);
-  NoisyPrior prior(seed + 7);
-  Eigen::Matrix3d T_w = Eigen::Matrix3d::Identity(), P = Eigen::Matrix3d::Zero();
-  Drive run;
-  double sum2 = 0.0, key2 = 0.0;
-  int keys = 0;
-  for (int k = 0; k < scans; ++k) {
-    const FeatureFrame f = scene.observe(k);
-    MotionEstimate pair = prior(scene, k, v);
-    const Eigen::Matrix3d T_prev = T_w, P_prev = P;
-    const int switches_was = kt.keyframeSwitches();
-    kt.track(f, T_prev, P_prev, 0.8, pair, T_w, P);
-    const Eigen::Matrix3d truth = scene.relative(0, k);
-    const Eigen::Vector3d t = se2::toXyYaw(truth), p = se2::toXyYaw(T_w);
-    Eigen::Vector3d e = p - t;
-    e(2) = std::atan2(std::sin(e(2)), std::cos(e(2)));
-    sum2 += e(2) * e(2);
-    if (k > 0 && kt.keyframeSwitches() != switches_was) {
-      key2 += e(2) * e(2);
-      ++keys;
-    }
-    if (k > 0) {
-      run.nees += e.dot(P.ldlt().solve(e));
-      run.heading_nees += e(2) * e(2) / P(2, 2);
-    }
-  }
-  run.heading_rms = std::sqrt(sum2 / scans);
-  run.key_heading_rms = keys > 0 ? std::sqrt(key2 / keys) : 0.0;
-  run.nees /= scans - 1;
-  run.heading_nees /= scans - 1;
-  run.switches = kt.keyframeSwitches();
-  run.fused = kt.fusionsAccepted();
-  run.refused = kt.fusionsRejected();
-  return run;
+  return spinradar::testing::glintDrive(seed, glint, cfg);
 }
 
 }  // namespace

@@ -334,6 +334,11 @@ class KeyframeTracker {
   /// fuses. M_k (mid-scan world pose) and P_m (its covariance) in/out. True when fused.
   bool fuseWithPast(const FeatureFrame& cur, double c, const Eigen::Matrix3d& T_jk,
                     const Eigen::Matrix3d& C_jk, Eigen::Matrix3d& M_k, Eigen::Matrix3d& P_m);
+  /// The chained prediction of cur's mid-scan pose relative to past_[i] and its covariance:
+  /// for i == 0 from the current keyframe's (T_jk, C_jk); for i > 0, X and C (relative to
+  /// past_[i - 1]) carried one keyframe further back.
+  void predictAgainstPast(size_t i, const Eigen::Matrix3d& T_jk, const Eigen::Matrix3d& C_jk,
+                          Eigen::Matrix3d& X, Eigen::Matrix3d& C) const;
   /// Registers cur against pk (swapped in as the keyframe) from the prediction T_pred (cur's
   /// mid-scan pose relative to pk's) with covariance C_pred: T (relative) and C ([x, y, yaw],
   /// the prior left out). False when the registration fails. graph: weak descriptor
