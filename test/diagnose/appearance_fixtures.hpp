@@ -15,6 +15,14 @@ inline sim::SensorConfig hundredMetreSensor() {
   return s;
 }
 
+/// All four bands with some clutter and noise texture for the range curves to act on.
+inline sim::SensorConfig curveSensor() {
+  sim::SensorConfig s = hundredMetreSensor();
+  s.clutter_density = 0.1;
+  s.noise_texture_db = 2.0;
+  return s;
+}
+
 /// Three scans per render keep each stage to a few seconds.
 inline AppearanceOptions quickAppearanceOptions() {
   AppearanceOptions o;

@@ -15,13 +15,7 @@
 namespace spinradar::diagnose {
 namespace {
 
-// All four bands with some clutter and noise texture for the curves to act on.
-sim::SensorConfig baseSensor() {
-  sim::SensorConfig s = testing::hundredMetreSensor();
-  s.clutter_density = 0.1;
-  s.noise_texture_db = 2.0;
-  return s;
-}
+sim::SensorConfig baseSensor() { return testing::curveSensor(); }
 
 AppearanceOptions quick() {
   AppearanceOptions o = testing::quickAppearanceOptions();

@@ -17,12 +17,7 @@
 namespace spinradar::diagnose {
 namespace {
 
-sim::SensorConfig baseSensor() {
-  sim::SensorConfig s = testing::hundredMetreSensor();
-  s.clutter_density = 0.1;
-  s.noise_texture_db = 2.0;
-  return s;
-}
+sim::SensorConfig baseSensor() { return testing::curveSensor(); }
 
 struct Start { double noise, returns, density; };
 
