@@ -18,7 +18,10 @@
 #
 # Usage: scripts/evaluation_matrix.sh [OUT_DIR]      (default build/evaluation_matrix)
 # Env: SPINRADAR_BIN (CLI), SCANS (scans per simulated column, default 480 = 2 min),
-#      THREADS (default 2), COLS / ROWS (space-separated labels to restrict to), SEED (1),
+#      THREADS (default 2), COLS / ROWS (space-separated labels to restrict to),
+#      SEEDS (noise seeds of every simulated column, default "1 2 3": one cell is one noise draw,
+#      and draws of one column differ up to 2x, so a cell is the mean over the seeds, printed with
+#      the seeds' range; SEED=n alone is SEEDS=n),
 #      STEP (devkit first-frame step, default 4), SHARED (default ../shared next to the repo),
 #      MERGE (further results.tsv files, e.g. of a run on other COLS, to print in the tables),
 #      TABLE_ONLY=1 (print the tables of OUT_DIR/results.tsv and MERGE, run nothing),
@@ -29,7 +32,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="${1:-$root/build/evaluation_matrix}"
 scans="${SCANS:-480}"
 threads="${THREADS:-2}"
-seed="${SEED:-1}"
+seeds="${SEEDS:-${SEED:-1 2 3}}"
 step="${STEP:-4}"
 shared="${SHARED:-$root/../shared}"
 city="${CITY_SCENE:-city}"
@@ -42,18 +45,20 @@ mkdir -p "$out"
 
 # --- rows: label = odometry options -------------------------------------------------------
 # Every row names its front end: azimuth_peaks is on by default since 2026-11-27, and the rows
-# without "+peaks" are the paper's front end (one keypoint per row at the row angle).
+# without "+peaks" are the paper's front end (one keypoint per row at the row angle). Every row
+# pins keyframe_graph, so a row means the same whatever the default ("+graph": window 6).
 declare -A row_args=(
   [rigid]="--estimator rigid --azimuth_peaks false"
   [mc]="--estimator mc --azimuth_peaks false"
   [mc_doppler]="--estimator mc_doppler --azimuth_peaks false"
   [refined]="--estimator refined --azimuth_peaks false"
-  [keyframe]="--estimator keyframe --azimuth_peaks false"
-  [keyframe+peaks]="--estimator keyframe --azimuth_peaks true"
-  [surface]="--estimator surface --azimuth_peaks false"
-  [surface+peaks]="--estimator surface --azimuth_peaks true"
+  [keyframe]="--estimator keyframe --azimuth_peaks false --keyframe_graph 0"
+  [keyframe+peaks]="--estimator keyframe --azimuth_peaks true --keyframe_graph 0"
+  [keyframe+peaks+graph]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6"
+  [surface]="--estimator surface --azimuth_peaks false --keyframe_graph 0"
+  [surface+peaks]="--estimator surface --azimuth_peaks true --keyframe_graph 0"
 )
-all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks surface surface+peaks)
+all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks keyframe+peaks+graph surface surface+peaks)
 # Rows whose estimator this CLI does not know are left out (older builds).
 rows=()
 for r in ${ROWS:-${all_rows[@]}}; do
@@ -137,9 +142,9 @@ print(f"clutter x{factor}: {len(extra)} scatterers added", file=sys.stderr)
 PY
 }
 
-simulate_column() {  # label scene variant sensor clutter [extra physics, JSON members]
-  local label="$1" scene="$2" variant="$3" sensor="$4" clutter="$5" extra="${6:-}"
-  local rec="$out/rec_$label" physics="$out/physics_full.json"
+simulate_column() {  # label seed scene variant sensor clutter [extra physics, JSON members]
+  local label="$1" seed="$2" scene="$3" variant="$4" sensor="$5" clutter="$6" extra="${7:-}"
+  local rec="$out/rec_${label}_s$seed" physics="$out/physics_full.json"
   if [[ -n "$extra" ]]; then
     physics="$out/physics_$label.json"
     sed "s/}\s*$/, $extra}/" "$out/physics_full.json" > "$physics"
@@ -161,8 +166,8 @@ simulate_column() {  # label scene variant sensor clutter [extra physics, JSON m
   else
     args+=(--scene "$scene" --variant "$variant")
   fi
-  echo "== simulating $label ($scans scans)" >&2
-  "$bin" "${args[@]}" 2> "$out/simulate_$label.log"
+  echo "== simulating $label, seed $seed ($scans scans)" >&2
+  "$bin" "${args[@]}" 2> "$out/simulate_${label}_s$seed.log"
   echo "$stamp" > "$rec/.spinradar_matrix"
 }
 
@@ -211,7 +216,7 @@ out = [{"consistency": {"yaw_rms_deg": rms(dy), "length_rms_m": rms(dl), "pairs"
 json.dump(out, open(sys.argv[4] + ".tmp", "w"))
 os.replace(sys.argv[4] + ".tmp", sys.argv[4])
 PY
-      printf '%s\t%s\t%s\t%s\n' "$label" "$r" "$held" "$e.json" >> "$results"
+      printf '%s\t%s\t%s\t%s\t-\n' "$label" "$r" "$held" "$e.json" >> "$results"
     done
     continue
   fi
@@ -230,77 +235,27 @@ PY
       # shellcheck disable=SC2086
       "$bin" odometry --input "$input" --format oxford --out "$e.csv" --quiet --threads "$threads" ${row_args[$r]} 2> "$e.log"
       "$bin" eval --est "$e.csv" --gt "$seq/gt/radar_odometry.csv" --json "$e.json" > /dev/null
-      printf '%s\t%s\t%s\t%s\n' "$label" "$r" "$held" "$e.json" >> "$results"
+      printf '%s\t%s\t%s\t%s\t-\n' "$label" "$r" "$held" "$e.json" >> "$results"
     done
     continue
   fi
-  simulate_column "$label" "$scene" "$variant" "$sensor" "$clutter" "$extra"
-  rec="$out/rec_$label"
-  # The recording's bin size (a calibrated sensor model may not have Oxford's 0.0438 m, which
-  # odometry assumes for Oxford-layout PNGs: RADIATE's 0.174 m read as 0.0438 gave 60 % drift).
-  res="$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1])).get("range_resolution", ""))' "$rec/sensor.json" 2> /dev/null || true)"
-  res_args=()
-  [[ -n "$res" ]] && res_args=(--range-resolution "$res")
-  for r in "${rows[@]}"; do
-    e="$out/${label}__$r"
-    echo "== $label: $r" >&2
-    # shellcheck disable=SC2086
-    "$bin" odometry --input "$rec" --out "$e.csv" --quiet --threads "$threads" "${res_args[@]}" ${row_args[$r]} 2> "$e.log"
-    "$bin" eval --est "$e.csv" --gt "$rec/trajectory.csv" --step "$step" --json "$e.json" > /dev/null
-    printf '%s\t%s\t%s\t%s\n' "$label" "$r" "$held" "$e.json" >> "$results"
+  for seed in $seeds; do
+    simulate_column "$label" "$seed" "$scene" "$variant" "$sensor" "$clutter" "$extra"
+    rec="$out/rec_${label}_s$seed"
+    # The recording's bin size (a calibrated sensor model may not have Oxford's 0.0438 m, which
+    # odometry assumes for Oxford-layout PNGs: RADIATE's 0.174 m read as 0.0438 gave 60 % drift).
+    res="$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1])).get("range_resolution", ""))' "$rec/sensor.json" 2> /dev/null || true)"
+    res_args=()
+    [[ -n "$res" ]] && res_args=(--range-resolution "$res")
+    for r in "${rows[@]}"; do
+      e="$out/${label}__${r}__s$seed"
+      echo "== $label, seed $seed: $r" >&2
+      # shellcheck disable=SC2086
+      "$bin" odometry --input "$rec" --out "$e.csv" --quiet --threads "$threads" "${res_args[@]}" ${row_args[$r]} 2> "$e.log"
+      "$bin" eval --est "$e.csv" --gt "$rec/trajectory.csv" --step "$step" --json "$e.json" > /dev/null
+      printf '%s\t%s\t%s\t%s\t%s\n' "$label" "$r" "$held" "$e.json" "$seed" >> "$results"
+    done
   done
 done
 
-/usr/bin/env python3 - "$scans" "$results" ${MERGE:-} <<'PY'
-import json, math, sys
-rows, cols, held, cell = [], [], {}, {}
-lines = [l for f in sys.argv[2:] for l in open(f)]
-for line in lines:
-    c, r, h, path = line.rstrip("\n").split("\t")
-    if c not in cols: cols.append(c)
-    if r not in rows: rows.append(r)
-    held[c] = h == "yes"
-    j = json.load(open(path))[0]
-    if "consistency" in j:
-        k = j["consistency"]
-        cell[c, r] = (k["yaw_rms_deg"], k["length_rms_m"], 0.0, k["pairs"]) if k["pairs"] else None
-        continue
-    if c.startswith("oxford_real"):
-        fr = j["frames"]
-        if not fr: cell[c, r] = None; continue
-        yaw = sum(math.degrees(f["r_err_rad"]) for f in fr) / len(fr)
-        t = sum(f["t_err_pct"] for f in fr) / len(fr)
-        cell[c, r] = (yaw, t, j.get("path_length_m", 0.0), len(fr))
-    else:
-        cell[c, r] = (j["t_err_pct"], j["r_err_deg_per_m"], j["path_length_m"], j["poses"]) if j["drift_valid"] else None
-# ms per scan of the chain (odometry log "total" line) is not parsed: see `spinradar bench`.
-def table(sel, title):
-    if not sel: return
-    print(f"\n{title}\n")
-    print("| estimator | " + " | ".join(sel) + " | worst ratio to the column's best |")
-    print("|---|" + "---|" * (len(sel) + 1))
-    best = {}
-    for c in sel:
-        v = [cell[c, r][0] for r in rows if cell.get((c, r))]
-        best[c] = min(v) if v else None
-    for r in rows:
-        out = []
-        for c in sel:
-            x = cell.get((c, r))
-            if not x: out.append("n/a"); continue
-            s = f"{x[0]:.3f} / {x[1]:.4f}" if c.startswith(("oxford_real", "radiate_real")) else f"{x[0]:.2f} / {x[1]:.4f}"
-            if best[c] is not None and x[0] <= 1.05 * best[c]: s = f"**{s}**"
-            out.append(s)
-        # The default is chosen by this: its worst ratio over the columns (first figure).
-        ratios = [cell[c, r][0] / best[c] for c in sel if cell.get((c, r)) and best[c]]
-        worst = f"{max(ratios):.2f}" if len(ratios) == len(sel) else "n/a"
-        print(f"| {r} | " + " | ".join(out) + f" | {worst} |")
-    lens = []
-    for c in sel:
-        x = next((cell[c, r] for r in rows if cell.get((c, r))), None)
-        if x: lens.append(f"{c}: {x[2]:.0f} m, {x[3]} {'pairs' if c.startswith(('oxford_real', 'radiate_real')) else 'scans'}")
-    print("\n" + "; ".join(lens))
-tuned = [c for c in cols if not held[c]]
-table(tuned, "Columns used while tuning (simulated: KITTI drift % / deg/m; oxford_real: mean yaw error deg / translation error % per pair; radiate_real_consistency: chain-vs-direct rms yaw deg / step length m over pairs two scans apart, no ground truth; bold: within 5 % of the column's best)")
-table([c for c in cols if held[c]], "Held-out columns (not looked at while tuning)")
-PY
+/usr/bin/env python3 "$root/scripts/evaluation_matrix_table.py" "$results" ${MERGE:-}
