@@ -18,6 +18,7 @@
 // docs/sensor_columns/round11_keyframe_graph.md.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
@@ -136,6 +137,23 @@ bool KeyframeTracker::solveGraph(const FeatureFrame& cur, double c, const Eigen:
     past_[i].M_w = se2::fromXyYaw(x[past_count_ - 1 - i]);
   T_wj_ = se2::fromXyYaw(x[n - 2]) * se2::exp(-key_c_ * key_xi_);
   return true;
+}
+
+Eigen::Vector3d KeyframeTracker::graphVelocityCorrection(const Eigen::Matrix3d& T_jk,
+                                                         const Eigen::Matrix3d& E_j,
+                                                         const Eigen::Matrix3d& M_k,
+                                                         const Eigen::Matrix<double, 6, 6>& Cd) const {
+  // T_wj_ holds the current keyframe's solved pose (solveGraph), so this is the solved
+  // relative pose; delta its left perturbation from the chained registration's.
+  const Eigen::Matrix3d T_solved = se2::inverse(T_wj_ * E_j) * M_k;
+  const Eigen::Vector3d delta = se2::log(T_solved * se2::inverse(T_jk));
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(Cd.topLeftCorner<3, 3>());
+  if (ldlt.info() != Eigen::Success || !delta.allFinite()) return Eigen::Vector3d::Zero();
+  Eigen::Vector3d dxi = Cd.bottomLeftCorner<3, 3>() * ldlt.solve(delta);
+  static const int mode = std::getenv("GRAPH_RATE_MODE") ? std::atoi(std::getenv("GRAPH_RATE_MODE")) : 0;
+  if (mode == 1) dxi = Eigen::Vector3d(0.0, 0.0, Cd(5, 2) / Cd(2, 2) * delta(2));
+  if (mode == 2) dxi = Eigen::Vector3d(0.0, 0.0, dxi(2));
+  return dxi.allFinite() ? dxi : Eigen::Vector3d::Zero();
 }
 
 }  // namespace spinradar

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
@@ -317,8 +319,9 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   // chain runs over the keyframes' mid-scan poses M_j = T_wj E_j (P_jm_), with cov_acc.
   Eigen::Matrix3d P_m_next;  // M_k's, should this scan become the keyframe
   Eigen::Matrix3d C_jk_acc, Cxi_k_acc;  // T_jk's [x, y, yaw] and xi_k's (keyframe_fusion)
+  const Eigen::Matrix<double, 6, 6> Cd_acc = withModelErrors(cov_acc);
   {
-    const Eigen::Matrix<double, 6, 6> Cd = withModelErrors(cov_acc);
+    const Eigen::Matrix<double, 6, 6>& Cd = Cd_acc;
     const Eigen::Matrix3d M_j = T_wj_ * E_j;
     const Eigen::Matrix3d T_mk = T_jk * se2::exp(-c * xi_k);  // this scan's start, from M_j
     Eigen::Matrix<double, 3, 6> J;
@@ -357,6 +360,14 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     if (config_.keyframe_graph > 0) new_edges_.assign(1, GraphEdge{key_stamp_, T_jk, C_jk_acc});
     const bool graphed = config_.keyframe_graph > 0 && !still &&
                          solveGraph(cur, c, T_jk, C_jk_acc, M_k, P_m_next);
+    if (graphed && config_.keyframe_graph_rate) {  // keyframe_graph.cpp
+      const Eigen::Vector3d dxi = graphVelocityCorrection(T_jk, E_j, M_k, Cd_acc);
+      if (std::getenv("SPINRADAR_DEBUG_GRAPH_RATE"))
+        std::fprintf(stderr, "graph_rate %.3f xi %.4f dxi %.4f %.4f %.5f\n",
+                     1e-9 * static_cast<double>(cur.stamp_ns), xi_key(2), dxi(0), dxi(1), dxi(2));
+      xi_key += dxi;
+      prev_xi_ = xi_key;
+    }
     if (graphed || (config_.keyframe_graph == 0 && config_.keyframe_fusion > 0 && !still &&
                     fuseWithPast(cur, c, T_jk, C_jk_acc, M_k, P_m_next))) {
       const Eigen::Matrix3d E_k = se2::exp(-c * xi_k);

@@ -317,6 +317,14 @@ class KeyframeTracker {
   /// poses (information-weighted least squares, the oldest held). M_k, P_m as fuseWithPast.
   bool solveGraph(const FeatureFrame& cur, double c, const Eigen::Matrix3d& T_jk,
                   const Eigen::Matrix3d& C_jk, Eigen::Matrix3d& M_k, Eigen::Matrix3d& P_m);
+  /// EstimatorConfig::keyframe_graph_rate (keyframe_graph.cpp): the velocity correction that
+  /// goes with the graph's correction of the new keyframe's mid-scan pose relative to the
+  /// current keyframe's (solved M_k against the chained T_jk; E_j the current keyframe's
+  /// mid-scan offset), from the chained registration's joint covariance Cd over [T_jk (left
+  /// perturbation), xi_k] (zero where xi_k is the pair velocity, cross terms zero).
+  Eigen::Vector3d graphVelocityCorrection(const Eigen::Matrix3d& T_jk, const Eigen::Matrix3d& E_j,
+                                          const Eigen::Matrix3d& M_k,
+                                          const Eigen::Matrix<double, 6, 6>& Cd) const;
   std::vector<PastKeyframe> past_;
   size_t past_count_ = 0;
   /// [x, y, yaw] covariance of the current keyframe's mid-scan pose relative to the keyframe
