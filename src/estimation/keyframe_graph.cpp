@@ -18,7 +18,6 @@
 // docs/sensor_columns/round11_keyframe_graph.md.
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
@@ -139,6 +138,21 @@ bool KeyframeTracker::solveGraph(const FeatureFrame& cur, double c, const Eigen:
   return true;
 }
 
+// EstimatorConfig::keyframe_graph_rate. Within a scan the yaw rate trades against the yaw (a
+// scan undistorted with one constant rate while the rate ramps has no single mid-scan pose),
+// so the chained registration's mid-scan pose and its velocity (where the registration's own
+// yaw rate is used, xi_key = xi) have correlated errors, and the scan-start pose it is
+// published at (mid-scan moved back by c xi) is better than either: at a turn entry of
+// city_narrow layout 2 (23.75 s, 25 -> 36 deg/s inside the scan) the mid-scan yaw was -0.51
+// deg off and the published one -0.02. The graph corrected the mid-scan yaw (+0.006) but not
+// the rate, and the published pose went +0.55 deg off and stayed so (the keyframe map was
+// undistorted with that rate). So the velocity takes the correction that goes with the graph's
+// pose correction under the registration's joint covariance (Gaussian conditioning of xi on the
+// relative pose, left perturbation): dxi = C_xi,T C_T,T^-1 delta. Where the pair velocity
+// is used its cross terms are zero (track()): no change. The keyframe's map and published
+// pose follow. Published yaw error at that turn entry 0.55 -> 0.06 deg (worst over t = 23.5-28
+// s 1.33 -> 0.45, no graph 0.98; sim_test_keyframe_graph_turn_entry); drift (keyframe+peaks,
+// window 6, seeds 1-3): docs/sensor_columns/round12_graph_rate.md.
 Eigen::Vector3d KeyframeTracker::graphVelocityCorrection(const Eigen::Matrix3d& T_jk,
                                                          const Eigen::Matrix3d& E_j,
                                                          const Eigen::Matrix3d& M_k,
@@ -149,10 +163,7 @@ Eigen::Vector3d KeyframeTracker::graphVelocityCorrection(const Eigen::Matrix3d& 
   const Eigen::Vector3d delta = se2::log(T_solved * se2::inverse(T_jk));
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(Cd.topLeftCorner<3, 3>());
   if (ldlt.info() != Eigen::Success || !delta.allFinite()) return Eigen::Vector3d::Zero();
-  Eigen::Vector3d dxi = Cd.bottomLeftCorner<3, 3>() * ldlt.solve(delta);
-  static const int mode = std::getenv("GRAPH_RATE_MODE") ? std::atoi(std::getenv("GRAPH_RATE_MODE")) : 0;
-  if (mode == 1) dxi = Eigen::Vector3d(0.0, 0.0, Cd(5, 2) / Cd(2, 2) * delta(2));
-  if (mode == 2) dxi = Eigen::Vector3d(0.0, 0.0, dxi(2));
+  const Eigen::Vector3d dxi = Cd.bottomLeftCorner<3, 3>() * ldlt.solve(delta);
   return dxi.allFinite() ? dxi : Eigen::Vector3d::Zero();
 }
 

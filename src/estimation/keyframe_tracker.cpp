@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
@@ -360,12 +358,9 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     if (config_.keyframe_graph > 0) new_edges_.assign(1, GraphEdge{key_stamp_, T_jk, C_jk_acc});
     const bool graphed = config_.keyframe_graph > 0 && !still &&
                          solveGraph(cur, c, T_jk, C_jk_acc, M_k, P_m_next);
-    if (graphed && config_.keyframe_graph_rate) {  // keyframe_graph.cpp
-      const Eigen::Vector3d dxi = graphVelocityCorrection(T_jk, E_j, M_k, Cd_acc);
-      if (std::getenv("SPINRADAR_DEBUG_GRAPH_RATE"))
-        std::fprintf(stderr, "graph_rate %.3f xi %.4f dxi %.4f %.4f %.5f\n",
-                     1e-9 * static_cast<double>(cur.stamp_ns), xi_key(2), dxi(0), dxi(1), dxi(2));
-      xi_key += dxi;
+    // keyframe_graph_rate: the velocity follows the graph's pose correction (keyframe_graph.cpp).
+    if (graphed && config_.keyframe_graph_rate) {
+      xi_key += graphVelocityCorrection(T_jk, E_j, M_k, Cd_acc);
       prev_xi_ = xi_key;
     }
     if (graphed || (config_.keyframe_graph == 0 && config_.keyframe_fusion > 0 && !still &&
