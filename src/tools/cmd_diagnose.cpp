@@ -33,6 +33,7 @@ struct DiagnoseArgs {
   bool no_resimulate = false, appearance = false;
   std::string sensor;  // base sensor model of the appearance stage (file or calibrated name)
   int appearance_scans = 4;
+  int appearance_iterations = 4;  // Newton steps of the catalogue fit (AppearanceOptions::iterations)
   int curve_iterations = 16, curve_starts = 3;
   std::vector<double> curve_start_offset;  // noise dB, returns dB, log2 density (measurement)
   bool no_holdout = false;
@@ -81,6 +82,7 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   s.validate();
   diagnose::AppearanceOptions opt;
   opt.scans = a.appearance_scans;
+  opt.iterations = a.appearance_iterations;
   opt.curve_iterations = a.curve_iterations;
   opt.curve_starts = a.curve_starts;
   for (size_t i = 0; i < a.curve_start_offset.size() && i < 3; ++i) opt.curve_start_offset[i] = a.curve_start_offset[i];
@@ -400,6 +402,11 @@ SPINRADAR_COMMAND(
                      "With --appearance-scene combined: hold the gain chain and beam of this "
                      "sensor (file or calibrated name, e.g. the city fit in config/sensors) "
                      "instead of fitting them with the city scene first");
+      app.add_option("--appearance-iterations", a->appearance_iterations,
+                     "Newton steps of the catalogue fit (0: the --sensor file's global terms "
+                     "are kept and only the range curves, leakage and glint are fitted)")
+          ->check(CLI::Range(0, 20))
+          ->capture_default_str();
       app.add_option("--appearance-scans", a->appearance_scans,
                      "Re-simulated scans per evaluation in the appearance fit")
           ->capture_default_str();
