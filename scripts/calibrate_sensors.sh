@@ -6,7 +6,9 @@
 # Needs the built CLI (scripts/cli_path.sh); about 20 minutes on one core with one start of the range curves (several times that with the default 3, --appearance-curve-starts), most of it Boreas-RT
 # (6848 bins). Each sample's report: OUT/<sample>/appearance/appearance.md.
 # Env: APPEARANCE_SCENE (the reference world of the fit, default city; city_facades: the city
-# with the far structure of real streets, docs/city_scene_far_structure.md).
+# with the far structure of real streets, docs/city_scene_far_structure.md); APPEARANCE_HOLD
+# (clutter: hold the clutter field at the start model's, i.e. off from the defaults, and fit the
+# sensor terms only; docs/diagnose_hold_clutter.md).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="${1:?usage: scripts/calibrate_sensors.sh OUT [REALDATA]}"
@@ -19,7 +21,7 @@ mkdir -p "$out"
 run() {  # name, diagnose arguments...
   local name="$1"; shift
   echo "== $name" >&2
-  "$cli" diagnose "$@" --appearance-scene "${APPEARANCE_SCENE:-city}" --out "$out/$name" > "$out/$name.log" 2>&1 \
+  "$cli" diagnose "$@" --appearance-scene "${APPEARANCE_SCENE:-city}" ${APPEARANCE_HOLD:+--appearance-hold "$APPEARANCE_HOLD"} --out "$out/$name" > "$out/$name.log" 2>&1 \
     || { echo "$name: diagnose failed, see $out/$name.log" >&2; exit 1; }
   local fitted="$out/$name/appearance/sensor_fitted.json"
   cp "$fitted" "$root/config/sensors/$name.json.tmp"

@@ -90,6 +90,18 @@ void setParam(SensorConfig& s, int type, int j, double p) {
   }
 }
 
+// The sensor key a column of the fit moves (isHeldParameter: held columns stay out of the fit).
+// Type 1 (the returns' level) is set through return_gain_db_*.
+std::string paramKey(int type, int j) {
+  static const char* const nodes[kBands] = {"5m", "16m", "35m", "71m"};
+  static const char* const globals[kGlobals] = {"noise_texture_db", "clutter_rcs_db", "power_scale",
+                                                "range_psf_sigma_bins"};
+  if (type == kTypes) return globals[j];
+  static const char* const curves[kTypes] = {"stc_curve_db_", "return_gain_db_",
+                                             "clutter_density_x_"};
+  return std::string(curves[type]) + nodes[j];
+}
+
 const char* const kFigureNames[kPerBand] = {"mean", "q90", "cacfar", "cen2018", "floor",
                                                "zeros"};
 
@@ -166,7 +178,12 @@ SensorConfig fitRangeCurvesOnce(const sim::RealismStats& real, const SensorConfi
                                 const sim::PhysicsConfig& physics, const AppearanceOptions& opt,
                                 int iterations, std::vector<std::string>* log, double* misfit) {
   SensorConfig cur = start;
-  if (cur.clutter_density <= 0) cur.clutter_density = 0.05;
+  if (cur.clutter_density <= 0 && !isHeldParameter(opt, "clutter_density")) cur.clutter_density = 0.05;
+  std::vector<bool> held(kCols);
+  for (int c = 0; c < kCols; ++c) {
+    const int t = std::min(c / kBands, kTypes);
+    held[c] = isHeldParameter(opt, paramKey(t, c - t * kBands));
+  }
   const Eigen::VectorXd target = logFigures(real, opt);
   auto eval = [&](const SensorConfig& s, Eigen::VectorXd& f) {
     try {
@@ -211,6 +228,7 @@ SensorConfig fitRangeCurvesOnce(const sim::RealismStats& real, const SensorConfi
       if (t == kTypes && j == 2 && cur.native_codes != 0) continue;  // column stays zero
       if (t == kTypes && j == 3 && !opt.fit_spread_bands) continue;  // opt-in
       if (t == 1 && opt.hold_gain_chain) continue;  // the returns' level is held (combined)
+      if (held[c]) continue;                          // e.g. the clutter field (hold_clutter)
       SensorConfig s = cur;
       setParam(s, t, j, getParam(cur, t, j) + step[t]);
       Eigen::VectorXd f;
@@ -228,6 +246,7 @@ SensorConfig fitRangeCurvesOnce(const sim::RealismStats& real, const SensorConfi
       }
       Eigen::VectorXd d = N.ldlt().solve(J.transpose() * w.asDiagonal() * r);
       if (opt.hold_gain_chain) d.segment(kBands, kBands).setZero();  // type 1: returns' level
+      for (int c = 0; c < kCols; ++c) if (held[c]) d[c] = 0;
       SensorConfig trial = cur;
       // Type 0 before type 1: setting the noise level keeps the returns' level.
       for (int c = 0; c < kCols; ++c) {
@@ -302,8 +321,9 @@ SensorConfig fitRangeCurves(const sim::RealismStats& real, const SensorConfig& g
   // curves were), then flat curves with the noise and the returns' level moved apart / together
   // by 6 dB and the clutter density x1/2, x2. Deterministic: fixed starts, fixed seed.
   const auto& o0 = opt.curve_start_offset;  // a moved start (measurement of the dependence)
-  const SensorConfig start =
-      o0[0] != 0 || o0[1] != 0 || o0[2] != 0 ? perturbCurveStart(given, o0[0], o0[1], o0[2]) : given;
+  const SensorConfig start = withHeldParameters(
+      o0[0] != 0 || o0[1] != 0 || o0[2] != 0 ? perturbCurveStart(given, o0[0], o0[1], o0[2]) : given,
+      given, opt);
   const int starts = std::clamp(opt.curve_starts, 1, 6);
   if (starts == 1) return fitRangeCurvesOnce(real, start, physics, opt, opt.curve_iterations, log, nullptr);
   SensorConfig flat = start;
@@ -313,7 +333,8 @@ SensorConfig fitRangeCurves(const sim::RealismStats& real, const SensorConfig& g
   std::vector<SensorConfig> s0 = {start};
   for (const Offset& o : kFlat) {
     if (static_cast<int>(s0.size()) == starts) break;
-    SensorConfig s = perturbCurveStart(flat, o.noise, o.returns, o.density);
+    // Held parameters (the clutter field under hold_clutter) start where the given start has them.
+    SensorConfig s = withHeldParameters(perturbCurveStart(flat, o.noise, o.returns, o.density), start, opt);
     if (s.toJson() != start.toJson()) s0.push_back(s);  // the given start may be flat already
   }
   SensorConfig best = start;

@@ -133,6 +133,28 @@ void alignLevels(const AppearanceFigures& real, SensorConfig& cur,
 
 }  // namespace detail
 
+const std::vector<std::string>& clutterFieldKeys() {
+  static const std::vector<std::string> k = {
+      "clutter_density",        "clutter_density_x_5m",  "clutter_density_x_16m",
+      "clutter_density_x_35m",  "clutter_density_x_71m", "clutter_rcs_db",
+      "clutter_rcs_sd_db"};
+  return k;
+}
+
+bool isHeldParameter(const AppearanceOptions& opt, const std::string& key) {
+  const auto& k = clutterFieldKeys();
+  return opt.hold_clutter && std::find(k.begin(), k.end(), key) != k.end();
+}
+
+SensorConfig withHeldParameters(const SensorConfig& s, const SensorConfig& start,
+                                const AppearanceOptions& opt) {
+  if (!opt.hold_clutter) return s;
+  nlohmann::json j = s.toJson();
+  const nlohmann::json from = start.toJson();
+  for (const auto& key : clutterFieldKeys()) j[key] = from.at(key);
+  return SensorConfig::fromJson(j);
+}
+
 std::vector<PolarScan> renderReference(const SensorConfig& sensor, const sim::PhysicsConfig& physics,
                                        const AppearanceOptions& opt, uint64_t seed) {
   if (opt.scene == "recording") return renderRecordingScene(sensor, physics, opt, seed);

@@ -80,13 +80,14 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& recording,
   const auto& params = appearanceParams();
   std::vector<int> active;
   for (int i = 0; i < int(params.size()); ++i) {
-    if ((!opt.fit_clutter && params[i].block == 4) ||
-        (!opt.fit_near_stc && params[i].kind == Kind::Range))
+    if ((!opt.fit_clutter && params[i].block == 4) || isHeldParameter(opt, params[i].key) ||
+        (!opt.fit_near_stc && params[i].kind == Kind::Range) ||
+        (opt.hold_gain_chain && notIdentifiableWithOwnScene(params[i].key)))  // combined
       continue;
-    if (opt.hold_gain_chain && notIdentifiableWithOwnScene(params[i].key)) continue;  // combined
     active.push_back(i);
   }
-  if (opt.fit_clutter && cur.clutter_density <= 0) cur.clutter_density = 0.05;  // start points
+  if (opt.hold_clutter) rep.notes.push_back("Clutter field held at the start sensor's values.");
+  if (opt.fit_clutter && !opt.hold_clutter && cur.clutter_density <= 0) cur.clutter_density = 0.05;
   if (opt.fit_near_stc && cur.stc_range <= 0) cur.stc_range = 10.0;
   if (opt.fit_clutter && cur.noise_texture_db <= 0) cur.noise_texture_db = 1.0;
   alignLevels(rep.real, cur, [&](const SensorConfig& s) { return figuresOf(s, phys); }, rep.notes,

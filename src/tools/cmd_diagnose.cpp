@@ -33,6 +33,7 @@ struct DiagnoseArgs {
   bool no_resimulate = false, appearance = false;
   std::string sensor;  // base sensor model of the appearance stage (file or calibrated name)
   int appearance_scans = 4;
+  int appearance_iterations = 4;  // Newton steps of the catalogue fit (AppearanceOptions::iterations)
   int curve_iterations = 16, curve_starts = 3;
   std::vector<double> curve_start_offset;  // noise dB, returns dB, log2 density (measurement)
   bool no_holdout = false;
@@ -47,6 +48,7 @@ struct DiagnoseArgs {
   bool scene_subbin = false;
   bool scene_clean = false;  // own scene by CLEAN instead of one scatterer per local maximum
   bool fit_spread = false;
+  std::string hold;  // held parameter group of the appearance fit ("" or "clutter")
   std::string holdout_split = diagnose::kDefaultHoldoutSplit;
   bool split_survey = false;  // only measure the real halves' difference under candidate splits
 };
@@ -80,6 +82,7 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   s.validate();
   diagnose::AppearanceOptions opt;
   opt.scans = a.appearance_scans;
+  opt.iterations = a.appearance_iterations;
   opt.curve_iterations = a.curve_iterations;
   opt.curve_starts = a.curve_starts;
   for (size_t i = 0; i < a.curve_start_offset.size() && i < 3; ++i) opt.curve_start_offset[i] = a.curve_start_offset[i];
@@ -94,6 +97,7 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   opt.scene_refine_passes = a.scene_refine;
   opt.scene_range_subbin = a.scene_subbin;
   opt.fit_spread_bands = a.fit_spread;
+  opt.hold_clutter = a.hold == "clutter";
   opt.holdout_split = a.holdout_split;
   if (!a.gain_chain.empty()) {
     if (opt.scene != "combined")
@@ -389,10 +393,20 @@ SPINRADAR_COMMAND(
       app.add_flag("--appearance-fit-spread", a->fit_spread,
                    "Let the per-band figures move the range spread too (CA-CFAR cells follow the "
                    "returns' width; docs/diagnose_scene.md)");
+      app.add_option("--appearance-hold", a->hold,
+                     "Hold a parameter group at the --sensor file's values and fit the rest: "
+                     "clutter (clutter_density, clutter_density_x_*, clutter_rcs_db, "
+                     "clutter_rcs_sd_db; docs/diagnose_hold_clutter.md)")
+          ->check(CLI::IsMember({"clutter"}));
       app.add_option("--appearance-gain-chain", a->gain_chain,
                      "With --appearance-scene combined: hold the gain chain and beam of this "
                      "sensor (file or calibrated name, e.g. the city fit in config/sensors) "
                      "instead of fitting them with the city scene first");
+      app.add_option("--appearance-iterations", a->appearance_iterations,
+                     "Newton steps of the catalogue fit (0: the --sensor file's global terms "
+                     "are kept and only the range curves, leakage and glint are fitted)")
+          ->check(CLI::Range(0, 20))
+          ->capture_default_str();
       app.add_option("--appearance-scans", a->appearance_scans,
                      "Re-simulated scans per evaluation in the appearance fit")
           ->capture_default_str();

@@ -126,6 +126,14 @@ struct AppearanceOptions {
   double level_db_min = 1.0, width_rel_min = 0.10, slope_min = 2.0;
   double ghost_ratio_min = 1.2;  ///< behind-hit bright share real / sim to name ghosts
   bool fit_clutter = true;     ///< include the textured clutter in the fit
+  /// Hold the textured clutter field (clutterFieldKeys: clutter_density, its range multipliers
+  /// clutter_density_x_*, clutter_rcs_db, clutter_rcs_sd_db) at the start sensor's values and fit
+  /// the sensor terms only: noise and receiver gain curves, return gain curve, noise texture,
+  /// beam, range spread, leakage, glint (CLI --appearance-hold clutter). With the city scenes the
+  /// full fit fills the far bands with a clutter carpet (Oxford: x20 at 35 and 71 m, the bound)
+  /// that hides far matches; held, the clutter stays what the start file (or the default, off)
+  /// says (docs/diagnose_hold_clutter.md).
+  bool hold_clutter = false;
   bool fit_near_stc = true;    ///< include the near-range STC ramp in the fit
   bool relinearise = true;     ///< recompute the figure Jacobian at every Newton step
   bool realism = true;         ///< realism tables before/after (with detectors)
@@ -174,6 +182,15 @@ struct AppearanceOptions {
   /// scene from one of the sensor (detail::holdoutSceneCheck; needs realism and holdout).
   bool holdout_scene_check = true;
 };
+
+/// The sensor keys of the textured clutter field, the one definition of what
+/// AppearanceOptions::hold_clutter holds.
+const std::vector<std::string>& clutterFieldKeys();
+/// Whether the fit keeps sensor key `key` at the start sensor's value under `opt`.
+bool isHeldParameter(const AppearanceOptions& opt, const std::string& key);
+/// `s` with every parameter `opt` holds set back to `start`'s value.
+sim::SensorConfig withHeldParameters(const sim::SensorConfig& s, const sim::SensorConfig& start,
+                                     const AppearanceOptions& opt);
 
 /// A per-band realism figure that measures the reference scene's geometry rather than the
 /// sensor: left out of the per-band fit (fitRangeCurves) and of the worst-gap figures, and
