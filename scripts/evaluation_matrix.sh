@@ -25,6 +25,8 @@
 #      STEP (devkit first-frame step, default 4), SHARED (default ../shared next to the repo),
 #      MERGE (further results.tsv files, e.g. of a run on other COLS, to print in the tables),
 #      TABLE_ONLY=1 (print the tables of OUT_DIR/results.tsv and MERGE, run nothing),
+#      LAYOUT_COLS (columns also run on street layouts 1 and 2, default city_wide city_narrow
+#      city_oxford city_mulran; "" for none),
 #      CITY_SCENE (the built-in scene of every city_* column, default city; city_facades adds
 #      the far structure of real streets, docs/city_scene_far_structure.md).
 set -euo pipefail
@@ -104,6 +106,15 @@ done
 for f in "$root"/config/sensors/*.json; do
   [[ -f "$f" ]] || continue
   cols_spec+=("city_$(basename "$f" .json)|$city|0|$(tr -d '\n' < "$f")|1|no")
+done
+# Layouts: some sensor columns again on two other street layouts of their scene (--variant 1, 2),
+# as <label>_v1 / _v2, printed in a table of their own (LAYOUT_COLS="" leaves them out).
+for base in ${LAYOUT_COLS-city_wide city_narrow city_oxford city_mulran}; do
+  for spec in "${cols_spec[@]}"; do
+    [[ "${spec%%|*}" == "$base" ]] || continue
+    IFS='|' read -r _ scene _ sensor clutter _ extra <<< "$spec"
+    for v in 1 2; do cols_spec+=("${base}_v$v|$scene|$v|$sensor|$clutter|layout|$extra"); done
+  done
 done
 cols_spec+=("oxford_real|-|-|-|-|no")
 # The same 3 real scans as one pair with twice the baseline (scan 1 -> 3, 0.5 s): a third

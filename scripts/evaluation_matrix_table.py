@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The evaluation matrix's tables (scripts/evaluation_matrix.sh) from its results.tsv files.
 
-Each results line: column, row, held out (yes/no), the eval JSON, the noise seed ("-" for real
+Each results line: column, row, held out (yes / no / layout: a column on another street layout,
+printed in a table of its own), the eval JSON, the noise seed ("-" for real
 columns; lines of older runs without it count as seed 1). A simulated cell is the mean over its
 seeds of KITTI drift % / deg/m, followed by the range of the drift over the seeds; the column's
 best and the "worst ratio" of a row are judged on those means, and only over seeds every row
@@ -45,7 +46,7 @@ def load(files):
                 cols.append(c)
             if r not in rows:
                 rows.append(r)
-            held[c] = h == "yes"
+            held[c] = h
             runs.setdefault((c, r), {})[seed] = read_cell(path, c)
     return rows, cols, held, runs
 
@@ -110,12 +111,16 @@ def main():
         sys.exit("usage: evaluation_matrix_table.py RESULTS.tsv [MORE.tsv ...]")
     rows, cols, held, runs = load(sys.argv[1:])
     cell = aggregate(runs)
-    table([c for c in cols if not held[c]],
+    table([c for c in cols if held[c] not in ("yes", "layout")],
           "Columns used while tuning (simulated: KITTI drift % / deg/m, mean over the noise seeds, "
           "(range of the drift over the seeds); oxford_real: mean yaw error deg / translation error % "
           "per pair; radiate_real_consistency: chain-vs-direct rms yaw deg / step length m over pairs "
           "two scans apart, no ground truth; bold: within 5 % of the column's best)", rows, cell, runs)
-    table([c for c in cols if held[c]], "Held-out columns (not looked at while tuning)", rows, cell, runs)
+    table([c for c in cols if held[c] == "layout"],
+          "Street layouts 1 and 2 of some sensor columns (--variant; KITTI drift % / deg/m, mean over "
+          "the noise seeds)", rows, cell, runs)
+    table([c for c in cols if held[c] == "yes"], "Held-out columns (not looked at while tuning)",
+          rows, cell, runs)
 
 
 if __name__ == "__main__":
