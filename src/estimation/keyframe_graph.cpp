@@ -66,10 +66,14 @@ bool KeyframeTracker::solveGraph(const FeatureFrame& cur, double c, const Eigen:
   }
   if (new_edges_.size() < 2) return false;  // the chain only: nothing to average
   // Nodes, oldest first: past_[count - 1] .. past_[0], the current keyframe, the new one.
+  // (graph_: buffers kept from switch to switch, no allocation after warm-up.)
   const int n = static_cast<int>(past_count_) + 2;
-  std::vector<int64_t> stamp(n);
-  std::vector<Eigen::Vector3d> x(n);
-  std::vector<const std::vector<GraphEdge>*> edges(n);
+  std::vector<int64_t>& stamp = graph_.stamp;
+  std::vector<Eigen::Vector3d>& x = graph_.x;
+  std::vector<const std::vector<GraphEdge>*>& edges = graph_.edges;
+  stamp.resize(n);
+  x.resize(n);
+  edges.resize(n);
   for (size_t i = 0; i < past_count_; ++i) {
     const int k = static_cast<int>(past_count_ - 1 - i);
     stamp[k] = past_[i].stamp;
@@ -82,8 +86,12 @@ bool KeyframeTracker::solveGraph(const FeatureFrame& cur, double c, const Eigen:
   stamp[n - 1] = cur.stamp_ns;
   x[n - 1] = se2::toXyYaw(M_j * T_jk);
   edges[n - 1] = &new_edges_;
-  std::vector<PoseGraphEdge> pg;
-  std::vector<int> candidates, new_index;  // the new keyframe's extra edges
+  std::vector<PoseGraphEdge>& pg = graph_.pg;
+  std::vector<int>& candidates = graph_.candidates;  // the new keyframe's extra edges
+  std::vector<int>& new_index = graph_.new_index;
+  pg.clear();
+  candidates.clear();
+  new_index.clear();
   for (int b = 1; b < n; ++b) {
     for (size_t k = 0; k < edges[b]->size(); ++k) {
       const GraphEdge& e = (*edges[b])[k];
@@ -102,11 +110,13 @@ bool KeyframeTracker::solveGraph(const FeatureFrame& cur, double c, const Eigen:
   // (pose_graph.cpp); an edge the rest of the window contradicts (chi-square, 99 %, 3 dof) is
   // dropped, the worst first, and not kept for later windows. Off: on the turn entry it was
   // meant for the edges agree within their covariances (round11 doc), and it lost the glint gain.
-  std::vector<bool> skip;
+  std::vector<bool>& skip = graph_.skip;
+  skip.clear();
   const int dropped =
       config_.keyframe_graph_screen ? screenEdges(x, pg, candidates, kFusionChi2, skip) : 0;
   if (dropped > 0) {
-    std::vector<GraphEdge> kept;
+    std::vector<GraphEdge>& kept = graph_.kept;
+    kept.clear();
     for (size_t k = 0; k < new_edges_.size(); ++k) {
       bool drop = false;
       for (size_t q = 0; q < candidates.size(); ++q)
@@ -119,13 +129,13 @@ bool KeyframeTracker::solveGraph(const FeatureFrame& cur, double c, const Eigen:
     fusions_rejected_ += dropped;
     if (new_edges_.size() < 2) return false;
   }
-  Eigen::MatrixXd Sigma;
-  if (!solvePoseGraph(x, pg, skip, &Sigma)) return false;
+  Eigen::Matrix3d Sigma_new;  // the new node's covariance (world axes)
+  if (!solvePoseGraph(x, pg, skip, Sigma_new, graph_.solve)) return false;
   // The new node's covariance relative to the held node (world axes -> the held node's).
   Eigen::Matrix3d G = Eigen::Matrix3d::Identity();
   const double c0 = std::cos(x[0](2)), s0 = std::sin(x[0](2));
   G.topLeftCorner<2, 2>() << c0, s0, -s0, c0;
-  Eigen::Matrix3d C_rel = G * Sigma.bottomRightCorner<3, 3>() * G.transpose();
+  Eigen::Matrix3d C_rel = G * Sigma_new * G.transpose();
   C_rel = 0.5 * (C_rel + C_rel.transpose());
   if (!C_rel.allFinite()) return false;
   const Eigen::Matrix3d M_0 = se2::fromXyYaw(x[0]);

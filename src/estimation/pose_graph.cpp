@@ -42,21 +42,24 @@ Eigen::Vector3d residual(const std::vector<Eigen::Vector3d>& x, const PoseGraphE
   return r;
 }
 
-}  // namespace
-
-bool solvePoseGraph(std::vector<Eigen::Vector3d>& x, const std::vector<PoseGraphEdge>& edges,
-                    const std::vector<bool>& skip, Eigen::MatrixXd* Sigma) {
+/// Gauss-Newton over the free nodes 1..n-1 with matrices of type Mat (dynamic, or bounded-size
+/// for the allocation-free path) and vectors Vec; scratch's vectors are reused.
+template <class Mat, class Vec>
+bool gaussNewton(std::vector<Eigen::Vector3d>& x, const std::vector<PoseGraphEdge>& edges,
+                 const std::vector<bool>& skip, PoseGraphScratch& scratch, Mat* Sigma) {
   const int n = static_cast<int>(x.size());
   if (n < 2) return false;
   const int m = 3 * (n - 1);
-  std::vector<Eigen::Vector3d> y = x;
-  Eigen::MatrixXd H(m, m);
-  Eigen::VectorXd g(m);
+  std::vector<Eigen::Vector3d>& y = scratch.y;
+  y.assign(x.begin(), x.end());
+  std::vector<char>& reached = scratch.reached;
+  Mat H(m, m);
+  Vec g(m), dx(m);
   for (int it = 0; it < kIterations; ++it) {
     H.setZero();
     g.setZero();
     // Nodes no edge reaches are held by a unit prior (they keep their given pose).
-    std::vector<bool> reached(n, false);
+    reached.assign(n, 0);
     for (size_t k = 0; k < edges.size(); ++k) {
       if (!skip.empty() && skip[k]) continue;
       const PoseGraphEdge& e = edges[k];
@@ -65,31 +68,57 @@ bool solvePoseGraph(std::vector<Eigen::Vector3d>& x, const std::vector<PoseGraph
       const Eigen::Vector3d r = residual(y, e, Ja, Jb);
       const Eigen::Matrix3d W = e.C.ldlt().solve(Eigen::Matrix3d::Identity());
       const int ib = 3 * (e.b - 1), ia = 3 * (e.a - 1);
-      reached[e.b] = true;
-      H.block<3, 3>(ib, ib) += Jb.transpose() * W * Jb;
-      g.segment<3>(ib) += Jb.transpose() * W * r;
+      reached[e.b] = 1;
+      H.template block<3, 3>(ib, ib) += Jb.transpose() * W * Jb;
+      g.template segment<3>(ib) += Jb.transpose() * W * r;
       if (e.a > 0) {
-        reached[e.a] = true;
-        H.block<3, 3>(ia, ia) += Ja.transpose() * W * Ja;
-        H.block<3, 3>(ia, ib) += Ja.transpose() * W * Jb;
-        H.block<3, 3>(ib, ia) += Jb.transpose() * W * Ja;
-        g.segment<3>(ia) += Ja.transpose() * W * r;
+        reached[e.a] = 1;
+        H.template block<3, 3>(ia, ia) += Ja.transpose() * W * Ja;
+        H.template block<3, 3>(ia, ib) += Ja.transpose() * W * Jb;
+        H.template block<3, 3>(ib, ia) += Jb.transpose() * W * Ja;
+        g.template segment<3>(ia) += Ja.transpose() * W * r;
       }
     }
     for (int k = 1; k < n; ++k)
-      if (!reached[k]) H.block<3, 3>(3 * (k - 1), 3 * (k - 1)) += Eigen::Matrix3d::Identity();
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
+      if (!reached[k]) H.template block<3, 3>(3 * (k - 1), 3 * (k - 1)) += Eigen::Matrix3d::Identity();
+    const Eigen::LDLT<Mat> ldlt(H);
     if (ldlt.info() != Eigen::Success) return false;
-    const Eigen::VectorXd dx = -ldlt.solve(g);
+    dx = -ldlt.solve(g);
     if (!dx.allFinite()) return false;
-    for (int k = 1; k < n; ++k) y[k] += dx.segment<3>(3 * (k - 1));
+    for (int k = 1; k < n; ++k) y[k] += dx.template segment<3>(3 * (k - 1));
     if (dx.cwiseAbs().maxCoeff() < 1e-9) break;
   }
   if (Sigma) {
-    *Sigma = H.ldlt().solve(Eigen::MatrixXd::Identity(m, m));
+    *Sigma = H.ldlt().solve(Mat::Identity(m, m));
     if (!Sigma->allFinite()) return false;
   }
   x = y;
+  return true;
+}
+
+}  // namespace
+
+bool solvePoseGraph(std::vector<Eigen::Vector3d>& x, const std::vector<PoseGraphEdge>& edges,
+                    const std::vector<bool>& skip, Eigen::MatrixXd* Sigma) {
+  PoseGraphScratch scratch;
+  return gaussNewton<Eigen::MatrixXd, Eigen::VectorXd>(x, edges, skip, scratch, Sigma);
+}
+
+bool solvePoseGraph(std::vector<Eigen::Vector3d>& x, const std::vector<PoseGraphEdge>& edges,
+                    const std::vector<bool>& skip, Eigen::Matrix3d& last_cov,
+                    PoseGraphScratch& scratch) {
+  constexpr int kMaxDof = 3 * (kPoseGraphMaxNodes - 1);
+  using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDof, kMaxDof>;
+  using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDof, 1>;
+  if (static_cast<int>(x.size()) > kPoseGraphMaxNodes) {  // larger: on the heap
+    Eigen::MatrixXd Sigma;
+    if (!gaussNewton<Eigen::MatrixXd, Eigen::VectorXd>(x, edges, skip, scratch, &Sigma)) return false;
+    last_cov = Sigma.bottomRightCorner<3, 3>();
+    return true;
+  }
+  SmallMat Sigma;
+  if (!gaussNewton<SmallMat, SmallVec>(x, edges, skip, scratch, &Sigma)) return false;
+  last_cov = Sigma.bottomRightCorner<3, 3>();
   return true;
 }
 

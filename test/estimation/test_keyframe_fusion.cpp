@@ -24,6 +24,9 @@ using Drive = spinradar::testing::GlintDrive;
 Drive drive(uint32_t seed, double glint, int fusion) {
   EstimatorConfig cfg;
   cfg.keyframe_fusion = fusion;
+  // keyframe_fusion acts only without the pose graph (keyframe_tracker.cpp: the graph takes
+  // the switch when keyframe_graph > 0, the default since 2026-11-27): pinned off here.
+  cfg.keyframe_graph = 0;
   return spinradar::testing::glintDrive(seed, glint, cfg);
 }
 

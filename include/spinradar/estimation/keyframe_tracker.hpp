@@ -62,6 +62,7 @@
 #include "spinradar/estimation/direction_scales.hpp"
 #include "spinradar/estimation/mc_ransac.hpp"
 #include "spinradar/estimation/motion_estimate.hpp"
+#include "spinradar/estimation/pose_graph.hpp"
 #include "spinradar/core/params.hpp"
 
 namespace spinradar {
@@ -75,6 +76,11 @@ class KeyframeTracker {
     submap_count_ = submap_next_ = 0;
     past_count_ = 0;
     key_edges_.clear();
+    // What the first keyframe after a reset is made with, as in a new tracker (the extra
+    // registrations of keyframe_graph / keyframe_fusion read them: a second pass differed).
+    key_rel_cov_.setZero();
+    accel_.setZero();
+    key_accel_.setZero();
   }
 
   /// cur: the newest scan (raw keypoints and descriptors). pair: the frame-to-frame estimate
@@ -312,6 +318,17 @@ class KeyframeTracker {
     std::vector<GraphEdge> edges;  ///< keyframe_graph: its edges to earlier keyframes
   };
   std::vector<GraphEdge> key_edges_, new_edges_;  ///< the current keyframe's, the new one's
+  /// solveGraph's buffers, kept so that a keyframe switch allocates nothing after warm-up.
+  struct GraphScratch {
+    std::vector<int64_t> stamp;
+    std::vector<Eigen::Vector3d> x;
+    std::vector<const std::vector<GraphEdge>*> edges;
+    std::vector<PoseGraphEdge> pg;
+    std::vector<int> candidates, new_index;
+    std::vector<bool> skip;
+    std::vector<GraphEdge> kept;
+    PoseGraphScratch solve;
+  } graph_;
   /// cur becomes the keyframe: registers it against every keyframe of the window (past_ and
   /// the current one, whose registration T_jk, C_jk is the scan's own) and solves the window's
   /// poses (information-weighted least squares, the oldest held). M_k, P_m as fuseWithPast.

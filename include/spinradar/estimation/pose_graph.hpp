@@ -24,6 +24,23 @@ struct PoseGraphEdge {
 bool solvePoseGraph(std::vector<Eigen::Vector3d>& x, const std::vector<PoseGraphEdge>& edges,
                     const std::vector<bool>& skip, Eigen::MatrixXd* Sigma);
 
+/// keyframe_graph's largest window: keyframe_graph <= 10 keyframes and the new one.
+constexpr int kPoseGraphMaxNodes = 11;
+
+/// Buffers solvePoseGraph reuses from call to call (the keyframe tracker keeps one).
+struct PoseGraphScratch {
+  std::vector<Eigen::Vector3d> y;
+  std::vector<char> reached;
+};
+
+/// As above, but only the last node's 3x3 block of Sigma (last_cov) is returned, and a graph
+/// of at most kPoseGraphMaxNodes nodes is solved without heap allocation (its matrices are
+/// bounded-size, on the stack; the vectors are scratch's, grown once): the keyframe
+/// estimator's hot path makes none after warm-up (test_keyframe_allocations). Same solution.
+bool solvePoseGraph(std::vector<Eigen::Vector3d>& x, const std::vector<PoseGraphEdge>& edges,
+                    const std::vector<bool>& skip, Eigen::Matrix3d& last_cov,
+                    PoseGraphScratch& scratch);
+
 /// Leave-one-out consistency of edge e with the rest of the graph: the graph solved without
 /// e (and without the edges already skipped) predicts e's measurement; returns the innovation's
 /// chi-square r^T (C_e + J Sigma J^T)^-1 r (3 dof), or a negative value when the graph without
