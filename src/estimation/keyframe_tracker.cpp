@@ -355,7 +355,10 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     // too and fuse (keyframe_fusion.cpp); its published pose and covariance follow.
     Eigen::Matrix3d M_k = T_wj_ * E_j * T_jk;
     // EstimatorConfig::keyframe_graph instead: a pose graph over the window (keyframe_graph.cpp).
-    if (config_.keyframe_graph > 0) new_edges_.assign(1, GraphEdge{key_stamp_, T_jk, C_jk_acc});
+    if (config_.keyframe_graph > 0) {  // its full window reserved: the edge vectors circulate
+      new_edges_.reserve(static_cast<size_t>(config_.keyframe_graph));
+      new_edges_.assign(1, GraphEdge{key_stamp_, T_jk, C_jk_acc});
+    }
     const bool graphed = config_.keyframe_graph > 0 && !still &&
                          solveGraph(cur, c, T_jk, C_jk_acc, M_k, P_m_next);
     // keyframe_graph_rate: the velocity follows the graph's pose correction (keyframe_graph.cpp).
