@@ -80,7 +80,8 @@ bool gaussNewton(std::vector<Eigen::Vector3d>& x, const std::vector<PoseGraphEdg
       }
     }
     for (int k = 1; k < n; ++k)
-      if (!reached[k]) H.template block<3, 3>(3 * (k - 1), 3 * (k - 1)) += Eigen::Matrix3d::Identity();
+      if (!reached[k])
+        H.template block<3, 3>(3 * (k - 1), 3 * (k - 1)) += Eigen::Matrix3d::Identity();
     const Eigen::LDLT<Mat> ldlt(H);
     if (ldlt.info() != Eigen::Success) return false;
     dx = -ldlt.solve(g);
@@ -112,7 +113,8 @@ bool solvePoseGraph(std::vector<Eigen::Vector3d>& x, const std::vector<PoseGraph
   using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDof, 1>;
   if (static_cast<int>(x.size()) > kPoseGraphMaxNodes) {  // larger: on the heap
     Eigen::MatrixXd Sigma;
-    if (!gaussNewton<Eigen::MatrixXd, Eigen::VectorXd>(x, edges, skip, scratch, &Sigma)) return false;
+    if (!gaussNewton<Eigen::MatrixXd, Eigen::VectorXd>(x, edges, skip, scratch, &Sigma))
+      return false;
     last_cov = Sigma.bottomRightCorner<3, 3>();
     return true;
   }

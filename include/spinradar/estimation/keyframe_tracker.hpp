@@ -331,7 +331,8 @@ class KeyframeTracker {
   } graph_;
   /// cur becomes the keyframe: registers it against every keyframe of the window (past_ and
   /// the current one, whose registration T_jk, C_jk is the scan's own) and solves the window's
-  /// poses (information-weighted least squares, the oldest held). M_k, P_m as fuseWithPast.
+  /// poses (information-weighted least squares, the oldest held). M_k as fuseWithPast; P_m
+  /// (the chained covariance) is left as given (keyframe_graph.cpp).
   bool solveGraph(const FeatureFrame& cur, double c, const Eigen::Matrix3d& T_jk,
                   const Eigen::Matrix3d& C_jk, Eigen::Matrix3d& M_k, Eigen::Matrix3d& P_m);
   /// EstimatorConfig::keyframe_graph_rate (keyframe_graph.cpp): the velocity correction that
