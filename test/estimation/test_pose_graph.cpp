@@ -137,3 +137,37 @@ TEST(PoseGraph, LeaveOneOutNeedsTheOtherEdgesToTieTheNodes) {
   std::vector<bool> skip;
   EXPECT_EQ(screenEdges(x0, edges, {0}, kGate, skip), 0);
 }
+
+// The keyframe tracker's allocation-free overload (bounded-size matrices, reused scratch) must
+// give the general solve's poses and the last node's block of its covariance, for windows up
+// to kPoseGraphMaxNodes and beyond it (the heap path), and stay near the truth.
+TEST(PoseGraph, ScratchOverloadGivesTheGeneralSolution) {
+  PoseGraphScratch scratch;
+  for (uint32_t seed = 1; seed <= 5; ++seed) {
+    const Window w = makeWindow(seed, false);
+    std::vector<Eigen::Vector3d> general = w.x0, small = w.x0;
+    Eigen::MatrixXd Sigma;
+    Eigen::Matrix3d last = Eigen::Matrix3d::Zero();
+    ASSERT_TRUE(solvePoseGraph(general, w.edges, {}, &Sigma));
+    ASSERT_TRUE(solvePoseGraph(small, w.edges, {}, last, scratch));
+    for (size_t k = 0; k < general.size(); ++k)
+      EXPECT_LT((small[k] - general[k]).norm(), 1e-12) << "seed " << seed << " node " << k;
+    EXPECT_LT((last - Sigma.bottomRightCorner<3, 3>()).norm(), 1e-12 * Sigma.norm());
+    EXPECT_LT(std::abs(small.back()(2) - w.truth.back()(2)), 0.5 * kDeg);
+  }
+  // A chain of kPoseGraphMaxNodes + 2 nodes (on the heap path) and one of 2 nodes.
+  for (int n : {kPoseGraphMaxNodes + 2, 2}) {
+    std::vector<Eigen::Vector3d> x(n, Eigen::Vector3d::Zero());
+    std::vector<PoseGraphEdge> edges;
+    for (int k = 1; k < n; ++k)
+      edges.push_back(PoseGraphEdge{k - 1, k, Eigen::Vector3d(1.0, 0.0, 0.01),
+                                    Eigen::Matrix3d::Identity() * 1e-4});
+    std::vector<Eigen::Vector3d> general = x, small = x;
+    Eigen::MatrixXd Sigma;
+    Eigen::Matrix3d last;
+    ASSERT_TRUE(solvePoseGraph(general, edges, {}, &Sigma));
+    ASSERT_TRUE(solvePoseGraph(small, edges, {}, last, scratch));
+    EXPECT_LT((small.back() - general.back()).norm(), 1e-9) << n;
+    EXPECT_LT((last - Sigma.bottomRightCorner<3, 3>()).norm(), 1e-9 * Sigma.norm()) << n;
+  }
+}
