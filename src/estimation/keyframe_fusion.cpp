@@ -34,7 +34,7 @@ namespace spinradar {
 void KeyframeTracker::swapKeyframe(PastKeyframe& pk) {
   std::swap(key_pts_, pk.pts);
   std::swap(key_tau_, pk.tau);
-  std::swap(key_by_x_, pk.by_x);
+  std::swap(key_grid_, pk.grid);
   std::swap(key_desc_, pk.desc);
   std::swap(key_desc_storage_, pk.desc_storage);
   std::swap(key_accel_, pk.accel);
@@ -99,7 +99,8 @@ bool KeyframeTracker::registerToPast(const FeatureFrame& cur, PastKeyframe& pk, 
     key_tau_m_.clear();
     for (const Match& m : matches_) {
       const Keypoint& k = cur.keypoints[m.i2];
-      addMatch(static_cast<size_t>(m.i1), k, 1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c);
+      addMatch(static_cast<size_t>(m.i1), cur, static_cast<size_t>(m.i2),
+               1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c);
     }
     ok = solveFrom(cov, cov_pub, cov_acc);
     if (!ok && graph) {  // keyframe_graph: a weak registration too (as track()'s)

@@ -40,8 +40,7 @@ constexpr double kGraphEdgeInflation = 2.0;
 }  // namespace
 
 bool KeyframeTracker::solveGraph(const FeatureFrame& cur, double c, const Eigen::Matrix3d& T_jk,
-                                 const Eigen::Matrix3d& C_jk, Eigen::Matrix3d& M_k,
-                                 Eigen::Matrix3d& P_m) {
+                                 const Eigen::Matrix3d& C_jk, Eigen::Matrix3d& M_k) {
   if (past_count_ == 0) return false;
   const Eigen::Matrix3d M_j = T_wj_ * se2::exp(key_c_ * key_xi_);
   // Extra registrations against past_[i], predicted along the chain (as fuseWithPast).
@@ -129,26 +128,14 @@ bool KeyframeTracker::solveGraph(const FeatureFrame& cur, double c, const Eigen:
     fusions_rejected_ += dropped;
     if (new_edges_.size() < 2) return false;
   }
-  Eigen::Matrix3d Sigma_new;  // the new node's covariance (world axes)
-  if (!solvePoseGraph(x, pg, skip, Sigma_new, graph_.solve)) return false;
-  // The new node's covariance relative to the held node (world axes -> the held node's).
-  Eigen::Matrix3d G = Eigen::Matrix3d::Identity();
-  const double c0 = std::cos(x[0](2)), s0 = std::sin(x[0](2));
-  G.topLeftCorner<2, 2>() << c0, s0, -s0, c0;
-  Eigen::Matrix3d C_rel = G * Sigma_new * G.transpose();
-  C_rel = 0.5 * (C_rel + C_rel.transpose());
-  if (!C_rel.allFinite()) return false;
-  const Eigen::Matrix3d M_0 = se2::fromXyYaw(x[0]);
-  const Eigen::Matrix3d P_0 = past_[past_count_ - 1].P_m;
-  // P_m (in: the chained covariance) is left as it is. The window's marginal compounded onto
-  // the held node's (P_window) treats the edges as independent, and they are not (the same
+  // The solved poses only: the new keyframe keeps its chained covariance.
+  // The window's marginal would treat the edges as independent, and they are not (the same
   // map points, the same undistortion): published, it made the accumulated pose
   // over-confident (test_keyframe_covariance, NEES mean against 3 expected: tight_turns peaks
   // 2.89 without the graph -> 8.79, city layout 2 rows 2.34 -> 7.73; the chained one with the
-  // graph's poses 3.29 and 2.17). The poses are the same either way (city_oxford_glint0.14:
-  // identical pose CSVs, 0.425 %).
-  Eigen::Matrix3d P_window;
-  se2::compoundXyYaw(M_0, P_0, se2::inverse(M_0) * se2::fromXyYaw(x[n - 1]), C_rel, M_k, P_window);
+  // graph's poses 3.29 and 2.17).
+  if (!solvePoseGraph(x, pg, skip, nullptr, graph_.solve)) return false;
+  M_k = se2::fromXyYaw(x[n - 1]);
   // The earlier nodes take their solved poses (for later predictions and windows).
   for (size_t i = 0; i + 1 < past_count_; ++i)
     past_[i].M_w = se2::fromXyYaw(x[past_count_ - 1 - i]);

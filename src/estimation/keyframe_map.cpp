@@ -41,7 +41,6 @@ void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d&
   if (tmp_kps_.capacity() < n) tmp_kps_.reserve(n + n / 2);
   if (key_pts_.capacity() < n) key_pts_.reserve(n + n / 2);
   if (key_tau_.capacity() < n) key_tau_.reserve(n + n / 2);
-  if (key_by_x_.capacity() < n) key_by_x_.reserve(n + n / 2);
   if (matches_.capacity() < n) {  // at most one match per keyframe row
     const size_t c = n + n / 2;
     matches_.reserve(c);
@@ -53,10 +52,7 @@ void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d&
   const int64_t ref_ns = f.stamp_ns + static_cast<int64_t>(std::llround(1e9 * c));
   undistortPoints(tmp_kps_, xi, ref_ns, key_pts_);
   averageWithSubmap(T_w * se2::exp(c * xi));  // its mid-scan world pose
-  // Sorted by x for the proximity search (associateByProximity).
-  key_by_x_.resize(n);
-  for (size_t i = 0; i < n; ++i) key_by_x_[i] = {key_pts_[i].x(), static_cast<int>(i)};
-  std::sort(key_by_x_.begin(), key_by_x_.end());
+  key_grid_.build(key_pts_);  // for the proximity search (associateByProximity)
   key_tau_.resize(n);
   for (size_t i = 0; i < n; ++i)
     key_tau_[i] = 1e-9 * static_cast<double>(f.keypoints[i].stamp_ns - ref_ns);
@@ -100,24 +96,13 @@ void KeyframeTracker::averageWithSubmap(const Eigen::Matrix3d& M_w) {
   }
   avg_sum_.assign(key_pts_.begin(), key_pts_.end());
   avg_n_.assign(n, 1);
-  const double gate = kSubmapGate, gate2 = gate * gate;
   for (size_t s = 0; s < submap_count_; ++s) {
     const SubmapFrame& o = submap_[s];
     const Eigen::Matrix3d T_on = se2::inverse(o.M_w) * M_w;  // the new frame in o's
     const Eigen::Matrix2d R = T_on.topLeftCorner<2, 2>();
     const Eigen::Vector2d t = T_on.topRightCorner<2, 1>();
     for (size_t i = 0; i < n; ++i) {
-      const Eigen::Vector2d p = R * key_pts_[i] + t;
-      double best = gate2;
-      int best_j = -1;
-      auto it = std::lower_bound(o.by_x.begin(), o.by_x.end(), std::make_pair(p.x() - gate, -1));
-      for (; it != o.by_x.end() && it->first <= p.x() + gate; ++it) {
-        const double d2 = (o.pts[static_cast<size_t>(it->second)] - p).squaredNorm();
-        if (d2 < best) {
-          best = d2;
-          best_j = it->second;
-        }
-      }
+      const int best_j = o.grid.nearest(R * key_pts_[i] + t, kSubmapGate);
       if (best_j < 0) continue;
       avg_sum_[i] += R.transpose() * (o.pts[static_cast<size_t>(best_j)] - t);
       ++avg_n_[i];
@@ -125,23 +110,29 @@ void KeyframeTracker::averageWithSubmap(const Eigen::Matrix3d& M_w) {
   }
   SubmapFrame& slot = submap_[submap_next_];
   slot.pts.assign(key_pts_.begin(), key_pts_.end());
-  slot.by_x.resize(n);
-  for (size_t i = 0; i < n; ++i) slot.by_x[i] = {key_pts_[i].x(), static_cast<int>(i)};
-  std::sort(slot.by_x.begin(), slot.by_x.end());
+  slot.grid.build(slot.pts);
   slot.M_w = M_w;
   submap_next_ = (submap_next_ + 1) % slots;
   submap_count_ = std::min(submap_count_ + 1, slots);
   for (size_t i = 0; i < n; ++i) key_pts_[i] = avg_sum_[i] / avg_n_[i];
 }
 
-void KeyframeTracker::addMatch(size_t key_index, const Keypoint& k, double tau) {
+void KeyframeTracker::cacheDirections(const FeatureFrame& cur) {
+  const size_t n = cur.keypoints.size();
+  if (cur_dirs_.capacity() < n) cur_dirs_.reserve(n + n / 2);
+  cur_dirs_.resize(n);
+  for (size_t i = 0; i < n; ++i)
+    cur_dirs_[i] = {std::cos(cur.keypoints[i].azimuth), -std::sin(cur.keypoints[i].azimuth)};
+}
+
+void KeyframeTracker::addMatch(size_t key_index, const FeatureFrame& cur, size_t i, double tau) {
   qx_.push_back(key_pts_[key_index].x());
   qy_.push_back(key_pts_[key_index].y());
   key_tau_m_.push_back(key_tau_[key_index]);
-  px_.push_back(k.x);
-  py_.push_back(k.y);
-  ux_.push_back(std::cos(k.azimuth));
-  uy_.push_back(-std::sin(k.azimuth));
+  px_.push_back(cur.keypoints[i].x);
+  py_.push_back(cur.keypoints[i].y);
+  ux_.push_back(cur_dirs_[i].x());
+  uy_.push_back(cur_dirs_[i].y());
   tau_.push_back(tau);
 }
 
@@ -156,28 +147,22 @@ void KeyframeTracker::associateByProximity(const FeatureFrame& cur, const Eigen:
     in_.reserve(n + n / 2);
     dirs_.reserve(n + n / 2);
   }
-  const double gate2 = gate * gate;
   const double beta = config_.beta;
-  for (const Keypoint& k : cur.keypoints) {
+  // The keypoints of one azimuth row share a stamp: its motion T_pred exp(tau xi) once a row.
+  Eigen::Matrix3d M = Eigen::Matrix3d::Identity();
+  double row_tau = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const Keypoint& k = cur.keypoints[i];
     const double tau = 1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c;
-    const double ux = std::cos(k.azimuth), uy = -std::sin(k.azimuth);
+    if (i == 0 || tau != row_tau) {
+      M = T_pred * se2::exp(tau * xi);
+      row_tau = tau;
+    }
+    const double ux = cur_dirs_[i].x(), uy = cur_dirs_[i].y();
     const double d = beta * (ux * xi(0) + uy * xi(1));
     const Eigen::Vector3d p(k.x + d * ux, k.y + d * uy, 1.0);
-    const Eigen::Vector2d qh = (T_pred * se2::exp(tau * xi) * p).head<2>();
-    // Only the keyframe points within the gate in x (key_by_x_ is sorted by x).
-    double best = gate2;
-    int best_j = -1;
-    auto it = std::lower_bound(key_by_x_.begin(), key_by_x_.end(),
-                               std::make_pair(qh.x() - gate, -1));
-    for (; it != key_by_x_.end() && it->first <= qh.x() + gate; ++it) {
-      const Eigen::Vector2d& kp = key_pts_[static_cast<size_t>(it->second)];
-      const double dx = kp.x() - qh.x(), dy = kp.y() - qh.y();
-      if (dx * dx + dy * dy < best) {
-        best = dx * dx + dy * dy;
-        best_j = it->second;
-      }
-    }
-    if (best_j >= 0) addMatch(static_cast<size_t>(best_j), k, tau);
+    const int best_j = key_grid_.nearest((M * p).head<2>(), gate);
+    if (best_j >= 0) addMatch(static_cast<size_t>(best_j), cur, i, tau);
   }
 }
 

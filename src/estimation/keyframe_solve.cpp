@@ -83,12 +83,19 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
     const double vx = xi(0), vy = xi(1);
     chi2 = 0.0;
     cnt = 0;
+    Eigen::Matrix3d E = Eigen::Matrix3d::Identity();
+    double E_tau = 0.0;
+    bool have_E = false;
     for (int m = 0; m < n; ++m) {
       if (!regate && !in_[m]) continue;
       const double ux = ux_[m], uy = uy_[m];
       const double d = beta * (ux * vx + uy * vy);
       const Eigen::Vector2d pc(px_[m] + d * ux, py_[m] + d * uy);
-      const Eigen::Matrix3d E = se2::exp(tau_[m] * xi);
+      if (!have_E || tau_[m] != E_tau) {  // matches of one azimuth row share tau
+        E = se2::exp(tau_[m] * xi);
+        E_tau = tau_[m];
+        have_E = true;
+      }
       const Eigen::Matrix2d CE = E.topLeftCorner<2, 2>();
       const Eigen::Vector2d g = CE * pc + E.topRightCorner<2, 1>();
       const Eigen::Vector2d qh = CT * g + tT;

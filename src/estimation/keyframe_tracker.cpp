@@ -26,6 +26,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   // The pair velocity's yaw rate changed by over kRampYawAccel in the last scan (a ramp).
   const bool pair_ramp = std::abs(pair.velocity(2) - prev_pair_xi_(2)) > kRampYawAccel * dt;
   row_step_ = rowQuantization(cur);
+  cacheDirections(cur);
   if (!has_key_) {
     se2::compoundXyYaw(T_w_prev, P_prev, pair.T_12, pair.T_12_cov, T_w, P);
     rel_key_stamp_ = cur.stamp_ns;
@@ -73,7 +74,8 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     key_tau_m_.clear();
     for (const Match& m : matches_) {
       const Keypoint& k = cur.keypoints[m.i2];
-      addMatch(static_cast<size_t>(m.i1), k, 1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c);
+      addMatch(static_cast<size_t>(m.i1), cur, static_cast<size_t>(m.i2),
+               1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c);
     }
     // The pair velocity is centred about half a scan before scan k's own; within a scan the
     // yaw rate is only weakly observable (it trades against the yaw), so this prior has to
@@ -360,7 +362,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
       new_edges_.assign(1, GraphEdge{key_stamp_, T_jk, C_jk_acc});
     }
     const bool graphed = config_.keyframe_graph > 0 && !still &&
-                         solveGraph(cur, c, T_jk, C_jk_acc, M_k, P_m_next);
+                         solveGraph(cur, c, T_jk, C_jk_acc, M_k);
     // keyframe_graph_rate: the velocity follows the graph's pose correction (keyframe_graph.cpp).
     if (graphed && config_.keyframe_graph_rate) {
       xi_key += graphVelocityCorrection(T_jk, E_j, M_k, Cd_acc);

@@ -106,21 +106,23 @@ bool solvePoseGraph(std::vector<Eigen::Vector3d>& x, const std::vector<PoseGraph
 }
 
 bool solvePoseGraph(std::vector<Eigen::Vector3d>& x, const std::vector<PoseGraphEdge>& edges,
-                    const std::vector<bool>& skip, Eigen::Matrix3d& last_cov,
+                    const std::vector<bool>& skip, Eigen::Matrix3d* last_cov,
                     PoseGraphScratch& scratch) {
   constexpr int kMaxDof = 3 * (kPoseGraphMaxNodes - 1);
   using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDof, kMaxDof>;
   using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDof, 1>;
   if (static_cast<int>(x.size()) > kPoseGraphMaxNodes) {  // larger: on the heap
     Eigen::MatrixXd Sigma;
-    if (!gaussNewton<Eigen::MatrixXd, Eigen::VectorXd>(x, edges, skip, scratch, &Sigma))
+    if (!gaussNewton<Eigen::MatrixXd, Eigen::VectorXd>(x, edges, skip, scratch,
+                                                       last_cov ? &Sigma : nullptr))
       return false;
-    last_cov = Sigma.bottomRightCorner<3, 3>();
+    if (last_cov) *last_cov = Sigma.bottomRightCorner<3, 3>();
     return true;
   }
   SmallMat Sigma;
-  if (!gaussNewton<SmallMat, SmallVec>(x, edges, skip, scratch, &Sigma)) return false;
-  last_cov = Sigma.bottomRightCorner<3, 3>();
+  if (!gaussNewton<SmallMat, SmallVec>(x, edges, skip, scratch, last_cov ? &Sigma : nullptr))
+    return false;
+  if (last_cov) *last_cov = Sigma.bottomRightCorner<3, 3>();
   return true;
 }
 

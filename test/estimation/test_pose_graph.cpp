@@ -149,7 +149,7 @@ TEST(PoseGraph, ScratchOverloadGivesTheGeneralSolution) {
     Eigen::MatrixXd Sigma;
     Eigen::Matrix3d last = Eigen::Matrix3d::Zero();
     ASSERT_TRUE(solvePoseGraph(general, w.edges, {}, &Sigma));
-    ASSERT_TRUE(solvePoseGraph(small, w.edges, {}, last, scratch));
+    ASSERT_TRUE(solvePoseGraph(small, w.edges, {}, &last, scratch));
     for (size_t k = 0; k < general.size(); ++k)
       EXPECT_LT((small[k] - general[k]).norm(), 1e-12) << "seed " << seed << " node " << k;
     EXPECT_LT((last - Sigma.bottomRightCorner<3, 3>()).norm(), 1e-12 * Sigma.norm());
@@ -166,7 +166,7 @@ TEST(PoseGraph, ScratchOverloadGivesTheGeneralSolution) {
     Eigen::MatrixXd Sigma;
     Eigen::Matrix3d last;
     ASSERT_TRUE(solvePoseGraph(general, edges, {}, &Sigma));
-    ASSERT_TRUE(solvePoseGraph(small, edges, {}, last, scratch));
+    ASSERT_TRUE(solvePoseGraph(small, edges, {}, &last, scratch));
     EXPECT_LT((small.back() - general.back()).norm(), 1e-9) << n;
     EXPECT_LT((last - Sigma.bottomRightCorner<3, 3>()).norm(), 1e-9 * Sigma.norm()) << n;
   }

@@ -62,6 +62,7 @@
 #include "spinradar/estimation/direction_scales.hpp"
 #include "spinradar/estimation/mc_ransac.hpp"
 #include "spinradar/estimation/motion_estimate.hpp"
+#include "spinradar/estimation/nearest_point_grid.hpp"
 #include "spinradar/estimation/pose_graph.hpp"
 #include "spinradar/core/params.hpp"
 
@@ -249,8 +250,8 @@ class KeyframeTracker {
   Eigen::Matrix3d rel_T_ = Eigen::Matrix3d::Identity(), rel_C_ = Eigen::Matrix3d::Zero();  ///< inliers of the first registration to this keyframe (0 = none yet)
   // Keyframe: points at its reference time in its frame, descriptors, pose.
   std::vector<Eigen::Vector2d> key_pts_;
-  std::vector<double> key_tau_;
-  std::vector<std::pair<double, int>> key_by_x_;  ///< (x, index) of key_pts_, sorted by x  ///< each keyframe point's time (s) after the keyframe's reference
+  std::vector<double> key_tau_;  ///< each keyframe point's time (s) after the keyframe's reference
+  NearestPointGrid key_grid_;    ///< key_pts_ for the proximity search
   cv::Mat key_desc_storage_, key_desc_;
   /// Keyframe: scan-start world pose and its covariance (published).
   Eigen::Matrix3d T_wj_ = Eigen::Matrix3d::Identity(), P_j_ = Eigen::Matrix3d::Zero();
@@ -276,13 +277,19 @@ class KeyframeTracker {
   /// Fills the match arrays by proximity to the prediction (see kProximityGate).
   void associateByProximity(const FeatureFrame& cur, const Eigen::Matrix3d& T_pred,
                             const Eigen::Vector3d& xi, double c, double gate);
-  void addMatch(size_t key_index, const Keypoint& k, double tau);
+  /// Appends the pair (keyframe point key_index, keypoint i of the tracked scan) to the match
+  /// arrays; tau: the keypoint's time (s) after the scan's reference.
+  void addMatch(size_t key_index, const FeatureFrame& cur, size_t i, double tau);
+  /// The tracked scan's keypoint directions (cos az, -sin az), computed once per scan in
+  /// track(): every association and extra registration reuses them.
+  std::vector<Eigen::Vector2d> cur_dirs_;
+  void cacheDirections(const FeatureFrame& cur);
   double row_step_ = 0.0;  ///< rowQuantization() of the scan being tracked
   /// The submap (EstimatorConfig::submap_keyframes, issue 19): the raw points of the last
   /// keyframes (a ring), each at its mid-scan reference, with its mid-scan world pose.
   struct SubmapFrame {
     std::vector<Eigen::Vector2d> pts;
-    std::vector<std::pair<double, int>> by_x;  ///< (x, index) of pts, sorted by x
+    NearestPointGrid grid;  ///< pts for the nearest-point search
     Eigen::Matrix3d M_w = Eigen::Matrix3d::Identity();
   };
   std::vector<SubmapFrame> submap_;
@@ -305,7 +312,7 @@ class KeyframeTracker {
   struct PastKeyframe {
     std::vector<Eigen::Vector2d> pts;
     std::vector<double> tau;
-    std::vector<std::pair<double, int>> by_x;
+    NearestPointGrid grid;
     cv::Mat desc_storage, desc;
     Eigen::Matrix3d M_w = Eigen::Matrix3d::Identity();  ///< mid-scan world pose
     Eigen::Matrix3d P_m = Eigen::Matrix3d::Zero();      ///< its covariance (P_jm_)
@@ -331,10 +338,10 @@ class KeyframeTracker {
   } graph_;
   /// cur becomes the keyframe: registers it against every keyframe of the window (past_ and
   /// the current one, whose registration T_jk, C_jk is the scan's own) and solves the window's
-  /// poses (information-weighted least squares, the oldest held). M_k as fuseWithPast; P_m
-  /// (the chained covariance) is left as given (keyframe_graph.cpp).
+  /// poses (information-weighted least squares, the oldest held). M_k as fuseWithPast; its
+  /// covariance stays the chained one (keyframe_graph.cpp).
   bool solveGraph(const FeatureFrame& cur, double c, const Eigen::Matrix3d& T_jk,
-                  const Eigen::Matrix3d& C_jk, Eigen::Matrix3d& M_k, Eigen::Matrix3d& P_m);
+                  const Eigen::Matrix3d& C_jk, Eigen::Matrix3d& M_k);
   /// EstimatorConfig::keyframe_graph_rate (keyframe_graph.cpp): the velocity correction that
   /// goes with the graph's correction of the new keyframe's mid-scan pose relative to the
   /// current keyframe's (solved M_k against the chained T_jk; E_j the current keyframe's

@@ -33,12 +33,12 @@ struct PoseGraphScratch {
   std::vector<char> reached;
 };
 
-/// As above, but only the last node's 3x3 block of Sigma (last_cov) is returned, and a graph
+/// As above, but only the last node's 3x3 block of Sigma (last_cov, if given) is returned, and a graph
 /// of at most kPoseGraphMaxNodes nodes is solved without heap allocation (its matrices are
 /// bounded-size, on the stack; the vectors are scratch's, grown once): the keyframe
 /// estimator's hot path makes none after warm-up (test_keyframe_allocations). Same solution.
 bool solvePoseGraph(std::vector<Eigen::Vector3d>& x, const std::vector<PoseGraphEdge>& edges,
-                    const std::vector<bool>& skip, Eigen::Matrix3d& last_cov,
+                    const std::vector<bool>& skip, Eigen::Matrix3d* last_cov,
                     PoseGraphScratch& scratch);
 
 /// Leave-one-out consistency of edge e with the rest of the graph: the graph solved without

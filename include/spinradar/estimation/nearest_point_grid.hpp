@@ -1,0 +1,41 @@
+// Nearest-point search over a keyframe's map points (KeyframeTracker): the points bucketed in
+// bands of y, each band sorted by x, so a query looks only at the few bands and the x range
+// within its gate. The x-sorted strip it replaces spanned the whole scan in y: with the
+// Oxford model's clutter it held hundreds of points per query, and at keyframe switches
+// (keyframe_graph) the search was the largest single cost (issue 19, thirteenth round).
+// The answer is the strip's, to the bit: the nearest point strictly within the gate, ties to
+// the smaller (x, index).
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace spinradar {
+
+class NearestPointGrid {
+ public:
+  /// Buckets the points (finite; others are never found). Reuses its buffers: no heap
+  /// allocation once they have held as many points.
+  void build(const std::vector<Eigen::Vector2d>& pts);
+  void clear();
+  bool empty() const { return entries_.empty(); }
+  /// The index of the nearest point with squared distance under gate^2 from q; -1 if none.
+  int nearest(const Eigen::Vector2d& q, double gate) const;
+
+  static constexpr double kBand = 1.0;  ///< m, band height (gates are 0.3-1.5 m)
+
+ private:
+  struct Entry {
+    double x, y;
+    int index;
+  };
+  int bandOf(double y) const;
+  std::vector<Entry> entries_;   ///< band by band, each band sorted by (x, index)
+  std::vector<int> band_start_;  ///< entries_ of band b: [band_start_[b], band_start_[b + 1])
+  std::vector<int> band_of_;     ///< build scratch: each point's band
+  double y0_ = 0.0, band_ = kBand;
+  int bands_ = 0;
+};
+
+}  // namespace spinradar

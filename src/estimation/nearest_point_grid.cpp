@@ -1,0 +1,93 @@
+#include "spinradar/estimation/nearest_point_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace spinradar {
+
+namespace {
+constexpr int kMaxBands = 1 << 16;  // a wider spread of y widens the bands instead
+
+// Grows with headroom, so that the next, slightly larger map does not reallocate.
+template <typename T>
+void fitSize(std::vector<T>& v, size_t n) {
+  if (v.capacity() < n) v.reserve(n + n / 2);
+  v.resize(n);
+}
+}  // namespace
+
+void NearestPointGrid::clear() {
+  entries_.clear();
+  band_start_.clear();
+  bands_ = 0;
+}
+
+int NearestPointGrid::bandOf(double y) const {
+  const double b = std::floor((y - y0_) / band_);
+  return b < 0.0 ? 0 : b >= bands_ ? bands_ - 1 : static_cast<int>(b);
+}
+
+void NearestPointGrid::build(const std::vector<Eigen::Vector2d>& pts) {
+  clear();
+  double lo = 0.0, hi = 0.0;
+  bool any = false;
+  for (const Eigen::Vector2d& p : pts) {
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y())) continue;
+    lo = any ? std::min(lo, p.y()) : p.y();
+    hi = any ? std::max(hi, p.y()) : p.y();
+    any = true;
+  }
+  if (!any) return;
+  y0_ = lo;
+  band_ = std::max(kBand, (hi - lo) / (kMaxBands - 1));
+  bands_ = static_cast<int>(std::floor((hi - lo) / band_)) + 1;
+  // Counting sort by band, then each band by (x, index).
+  fitSize(band_start_, static_cast<size_t>(bands_) + 1);
+  std::fill(band_start_.begin(), band_start_.end(), 0);
+  fitSize(band_of_, pts.size());
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const bool finite = std::isfinite(pts[i].x()) && std::isfinite(pts[i].y());
+    band_of_[i] = finite ? bandOf(pts[i].y()) : -1;
+    if (finite) ++band_start_[static_cast<size_t>(band_of_[i]) + 1];
+  }
+  for (int b = 0; b < bands_; ++b) band_start_[b + 1] += band_start_[b];
+  fitSize(entries_, static_cast<size_t>(band_start_[bands_]));
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (band_of_[i] < 0) continue;
+    // band_start_[b] walks forward while filling; restored below.
+    entries_[static_cast<size_t>(band_start_[band_of_[i]]++)] = {pts[i].x(), pts[i].y(),
+                                                                  static_cast<int>(i)};
+  }
+  for (int b = bands_; b > 0; --b) band_start_[b] = band_start_[b - 1];
+  band_start_[0] = 0;
+  for (int b = 0; b < bands_; ++b)
+    std::sort(entries_.begin() + band_start_[b], entries_.begin() + band_start_[b + 1],
+              [](const Entry& a, const Entry& c) {
+                return a.x < c.x || (a.x == c.x && a.index < c.index);
+              });
+}
+
+int NearestPointGrid::nearest(const Eigen::Vector2d& q, double gate) const {
+  if (bands_ == 0 || !(gate > 0.0) || !std::isfinite(q.x()) || !std::isfinite(q.y())) return -1;
+  double best = gate * gate, best_x = 0.0;
+  int best_j = -1;
+  const int b_hi = bandOf(q.y() + gate);
+  for (int b = bandOf(q.y() - gate); b <= b_hi; ++b) {
+    const auto first = entries_.begin() + band_start_[b], last = entries_.begin() + band_start_[b + 1];
+    auto it = std::lower_bound(first, last, q.x() - gate,
+                               [](const Entry& e, double x) { return e.x < x; });
+    for (; it != last && it->x <= q.x() + gate; ++it) {
+      const double dx = it->x - q.x(), dy = it->y - q.y(), d2 = dx * dx + dy * dy;
+      // Ties (equal squared distance) to the smaller (x, index), the x-strip's order.
+      if (d2 < best || (best_j >= 0 && d2 == best &&
+                        (it->x < best_x || (it->x == best_x && it->index < best_j)))) {
+        best = d2;
+        best_x = it->x;
+        best_j = it->index;
+      }
+    }
+  }
+  return best_j;
+}
+
+}  // namespace spinradar

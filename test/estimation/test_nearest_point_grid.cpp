@@ -1,0 +1,89 @@
+// NearestPointGrid (the keyframe map's proximity search): against a scan over every point,
+// on random maps shaped like a scan (points to 150 m, clustered along walls, duplicated
+// points for exact ties), at every gate the keyframe tracker uses; and the buffers are reused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "spinradar/estimation/nearest_point_grid.hpp"
+
+using namespace spinradar;
+
+namespace {
+
+// The reference: the x-sorted strip's answer, i.e. the smallest squared distance under
+// gate^2, ties to the smaller (x, index).
+int bruteNearest(const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector2d& q, double gate) {
+  double best = gate * gate;
+  int best_j = -1;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const double dx = pts[i].x() - q.x(), dy = pts[i].y() - q.y(), d2 = dx * dx + dy * dy;
+    const bool tie_wins = best_j >= 0 && d2 == best &&
+                          (pts[i].x() < pts[best_j].x() ||
+                           (pts[i].x() == pts[best_j].x() && static_cast<int>(i) < best_j));
+    if (d2 < best || tie_wins) {
+      best = d2;
+      best_j = static_cast<int>(i);
+    }
+  }
+  return best_j;
+}
+
+std::vector<Eigen::Vector2d> scanLikeMap(std::mt19937& rng, int n) {
+  std::uniform_real_distribution<double> u(-150.0, 150.0), wall(-1.0, 1.0);
+  std::vector<Eigen::Vector2d> pts;
+  for (int i = 0; i < n; ++i) {
+    if (i % 3 == 0)
+      pts.emplace_back(u(rng), 12.0 + 0.3 * wall(rng));  // a wall along x
+    else
+      pts.emplace_back(u(rng), u(rng));
+    if (i % 50 == 0) pts.push_back(pts.back());  // an exact duplicate: a tie
+  }
+  return pts;
+}
+
+}  // namespace
+
+TEST(NearestPointGrid, SameAnswerAsAScanOverEveryPoint) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-160.0, 160.0), near(-2.0, 2.0);
+  NearestPointGrid grid;
+  int found = 0, queries = 0;
+  for (int map = 0; map < 5; ++map) {
+    const std::vector<Eigen::Vector2d> pts = scanLikeMap(rng, 3000);
+    grid.build(pts);
+    for (int k = 0; k < 4000; ++k) {
+      // Half the queries close to a map point (the tracker's case), half anywhere.
+      const Eigen::Vector2d q = k % 2 ? pts[static_cast<size_t>(k) % pts.size()] +
+                                            Eigen::Vector2d(near(rng), near(rng))
+                                      : Eigen::Vector2d(u(rng), u(rng));
+      for (const double gate : {0.3, 0.5, 0.6, 1.5, 2.0}) {
+        const int want = bruteNearest(pts, q, gate);
+        ASSERT_EQ(grid.nearest(q, gate), want) << "map " << map << " query " << k << " gate " << gate;
+        found += want >= 0;
+        ++queries;
+      }
+    }
+    // A query on a duplicated point: distance 0 to both copies, the smaller index wins.
+    ASSERT_EQ(grid.nearest(pts[1], 0.3), bruteNearest(pts, pts[1], 0.3));
+  }
+  EXPECT_GT(found, queries / 5);  // the comparison covered hits (23 %), not only misses
+}
+
+TEST(NearestPointGrid, EmptyNonFiniteAndWideMaps) {
+  NearestPointGrid grid;
+  grid.build({});
+  EXPECT_TRUE(grid.empty());
+  EXPECT_EQ(grid.nearest({0.0, 0.0}, 1.0), -1);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // Non-finite points are never returned; a y spread of 1e9 m widens the bands, still exact.
+  const std::vector<Eigen::Vector2d> pts = {{nan, 1.0}, {0.0, 0.0}, {1.0, 1e9}, {0.2, 0.1}};
+  grid.build(pts);
+  EXPECT_EQ(grid.nearest({0.15, 0.1}, 0.3), 3);
+  EXPECT_EQ(grid.nearest({1.0, 1e9 + 0.1}, 0.3), 2);
+  EXPECT_EQ(grid.nearest({nan, 0.0}, 0.3), -1);
+  EXPECT_EQ(grid.nearest({0.0, 0.0}, nan), -1);
+  EXPECT_EQ(grid.nearest({0.0, -0.5}, 0.5), -1);  // at exactly the gate: not within it
+}
