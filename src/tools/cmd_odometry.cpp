@@ -23,6 +23,7 @@
 #include "pipeline_options.hpp"
 #include "progress.hpp"
 #include "recording_sensor.hpp"
+#include "stage_tally.hpp"
 #include "spinradar/estimation/odometry.hpp"
 #include "spinradar/features/cartesian_tables.hpp"
 #include "spinradar/features/feature_extractor.hpp"
@@ -200,25 +201,6 @@ class ScanPrefetcher {
   std::vector<std::thread> threads_;
 };
 
-void printStageTotals(const StageTimes& t, double load_ms, double wait_ms, bool prefetch, size_t scans,
-                      double wall_s) {
-  const double n = scans > 0 ? static_cast<double>(scans) : 1.0;
-  std::fprintf(stderr, "stage timing over %zu scans (total s, mean ms/scan):\n", scans);
-  auto row = [&](const char* name, double ms) {
-    std::fprintf(stderr, "  %-18s %9.3f s  %8.2f ms\n", name, ms / 1000.0, ms / n);
-  };
-  row(prefetch ? "load (background)" : "load", load_ms);
-  if (prefetch) row("waiting for loads", wait_ms);
-  row(prefetch ? "detect (bg)" : "detect", t.detect_ms);
-  row(prefetch ? "cartesian (bg)" : "cartesian", t.cartesian_ms);
-  row(prefetch ? "describe (bg)" : "describe", t.describe_ms);
-  row("match", t.match_ms);
-  row("estimate", t.estimate_ms);
-  row("pipeline total", t.total());
-  std::fprintf(stderr, "  %-18s %9.3f s  %8.2f ms  (%.1f scans/s)\n", "wall clock", wall_s,
-               1000.0 * wall_s / n, scans / std::max(wall_s, 1e-9));
-}
-
 void run(OdometryArgs& a) {
   namespace fs = std::filesystem;
   cli::preferHugePageHeap();  // before the scans' buffers and the loader threads
@@ -281,7 +263,7 @@ void run(OdometryArgs& a) {
         << C(1, 2) << ',' << C(2, 2);
   };
   cli::Progress progress("scan", folder.size());
-  StageTimes totals;
+  cli::StageTally tally(folder.size());
   double load_ms = 0;
   size_t failures = 0;
   const auto wall0 = std::chrono::steady_clock::now();
@@ -327,7 +309,7 @@ void run(OdometryArgs& a) {
       odometry.process(l.frame, l.times, r);
     else
       odometry.process(l.scan, r);
-    totals += r.times;
+    tally.add(r.times);
     if (i > 0 && !r.ok) ++failures;
     PoseRecord p;
     p.t = r.stamp_ns * 1e-9;
@@ -364,7 +346,7 @@ void run(OdometryArgs& a) {
   if (cov_file) cov_file->commit();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  printStageTotals(totals, load_ms, wait_ms, prefetch, folder.size(), wall);
+  tally.print(load_ms, wait_ms, prefetch, folder.size(), wall);
   if (prefetch) {
     std::fprintf(stderr, "  thread CPU: main %.0f ms, loaders", threadCpuMs());
     for (double ms : prefetcher->workerCpuMs()) std::fprintf(stderr, " %.0f", ms);
