@@ -148,20 +148,27 @@ void KeyframeTracker::associateByProximity(const FeatureFrame& cur, const Eigen:
     dirs_.reserve(n + n / 2);
   }
   const double beta = config_.beta;
-  // The keypoints of one azimuth row share a stamp: its motion T_pred exp(tau xi) once a row.
-  Eigen::Matrix3d M = Eigen::Matrix3d::Identity();
+  // Keypoints of one stamp (a row; with azimuth peaks each has its own) share the motion
+  // M = T_pred exp(tau xi): its top two rows, written out (Eigen's 3x3 temporaries stalled on
+  // store forwarding; the same sums in the same order, so the same bits).
+  double M[2][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}};
   double row_tau = 0.0;
   for (size_t i = 0; i < n; ++i) {
     const Keypoint& k = cur.keypoints[i];
     const double tau = 1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c;
     if (i == 0 || tau != row_tau) {
-      M = T_pred * se2::exp(tau * xi);
+      const Eigen::Matrix3d E = se2::exp(tau * xi);
+      for (int r = 0; r < 2; ++r)
+        for (int col = 0; col < 3; ++col)
+          M[r][col] = T_pred(r, 0) * E(0, col) + T_pred(r, 1) * E(1, col) + T_pred(r, 2) * E(2, col);
       row_tau = tau;
     }
     const double ux = cur_dirs_[i].x(), uy = cur_dirs_[i].y();
     const double d = beta * (ux * xi(0) + uy * xi(1));
-    const Eigen::Vector3d p(k.x + d * ux, k.y + d * uy, 1.0);
-    const int best_j = key_grid_.nearest((M * p).head<2>(), gate);
+    const double px = k.x + d * ux, py = k.y + d * uy;
+    const Eigen::Vector2d qh(M[0][0] * px + M[0][1] * py + M[0][2],
+                             M[1][0] * px + M[1][1] * py + M[1][2]);
+    const int best_j = key_grid_.nearest(qh, gate);
     if (best_j >= 0) addMatch(static_cast<size_t>(best_j), cur, i, tau);
   }
 }

@@ -22,9 +22,10 @@ void NearestPointGrid::clear() {
   bands_ = 0;
 }
 
+// Monotone in y (all a query needs: the bands of [y - gate, y + gate] hold every point there).
 int NearestPointGrid::bandOf(double y) const {
-  const double b = std::floor((y - y0_) / band_);
-  return b < 0.0 ? 0 : b >= bands_ ? bands_ - 1 : static_cast<int>(b);
+  const double b = (y - y0_) * inv_band_;
+  return !(b >= 0.0) ? 0 : b >= bands_ ? bands_ - 1 : static_cast<int>(b);
 }
 
 void NearestPointGrid::build(const std::vector<Eigen::Vector2d>& pts) {
@@ -39,8 +40,9 @@ void NearestPointGrid::build(const std::vector<Eigen::Vector2d>& pts) {
   }
   if (!any) return;
   y0_ = lo;
-  band_ = std::max(kBand, (hi - lo) / (kMaxBands - 1));
-  bands_ = static_cast<int>(std::floor((hi - lo) / band_)) + 1;
+  const double band = std::max(kBand, (hi - lo) / (kMaxBands - 1));
+  inv_band_ = 1.0 / band;
+  bands_ = static_cast<int>(std::floor((hi - lo) * inv_band_)) + 1;
   // Counting sort by band, then each band by (x, index).
   fitSize(band_start_, static_cast<size_t>(bands_) + 1);
   std::fill(band_start_.begin(), band_start_.end(), 0);
@@ -67,15 +69,28 @@ void NearestPointGrid::build(const std::vector<Eigen::Vector2d>& pts) {
               });
 }
 
+// A binary search without branches on the data (conditional moves): the bands are short and
+// the queries random, so a branching search mispredicted on most steps (perf, Oxford model).
+const NearestPointGrid::Entry* NearestPointGrid::firstAtOrAfter(int b, double x) const {
+  const Entry* base = entries_.data() + band_start_[b];
+  size_t n = static_cast<size_t>(band_start_[b + 1] - band_start_[b]);
+  if (n == 0) return base;
+  while (n > 1) {
+    const size_t half = n / 2;
+    base = base[half - 1].x < x ? base + half : base;
+    n -= half;
+  }
+  return base + (base->x < x ? 1 : 0);
+}
+
 int NearestPointGrid::nearest(const Eigen::Vector2d& q, double gate) const {
   if (bands_ == 0 || !(gate > 0.0) || !std::isfinite(q.x()) || !std::isfinite(q.y())) return -1;
   double best = gate * gate, best_x = 0.0;
   int best_j = -1;
   const int b_hi = bandOf(q.y() + gate);
   for (int b = bandOf(q.y() - gate); b <= b_hi; ++b) {
-    const auto first = entries_.begin() + band_start_[b], last = entries_.begin() + band_start_[b + 1];
-    auto it = std::lower_bound(first, last, q.x() - gate,
-                               [](const Entry& e, double x) { return e.x < x; });
+    const Entry* it = firstAtOrAfter(b, q.x() - gate);
+    const Entry* const last = entries_.data() + band_start_[b + 1];
     for (; it != last && it->x <= q.x() + gate; ++it) {
       const double dx = it->x - q.x(), dy = it->y - q.y(), d2 = dx * dx + dy * dy;
       // Ties (equal squared distance) to the smaller (x, index), the x-strip's order.

@@ -31,10 +31,11 @@ class NearestPointGrid {
     int index;
   };
   int bandOf(double y) const;
+  const Entry* firstAtOrAfter(int band, double x) const;  ///< first entry of band with x >= x
   std::vector<Entry> entries_;   ///< band by band, each band sorted by (x, index)
   std::vector<int> band_start_;  ///< entries_ of band b: [band_start_[b], band_start_[b + 1])
   std::vector<int> band_of_;     ///< build scratch: each point's band
-  double y0_ = 0.0, band_ = kBand;
+  double y0_ = 0.0, inv_band_ = 1.0 / kBand;
   int bands_ = 0;
 };
 
