@@ -37,9 +37,10 @@ std::vector<FeatureFrame> simulatedSequence() {
 
 TEST(KeyframeAllocations, NoneAfterWarmUp) {
   const std::vector<FeatureFrame> frames = simulatedSequence();
-  auto perScan = [&](const char* estimator) {
+  auto perScan = [&](const char* estimator, bool graph_step = false) {
     PipelineConfig cfg;
     cfg.estimator.estimator = estimator;
+    cfg.estimator.keyframe_graph_step = graph_step;
     Odometry odo(cfg);
     for (int k = 0; k < kWarmUp; ++k) EXPECT_EQ(odo.process(frames[k]).ok, k > 0);
     const long before = g_allocations;
@@ -51,10 +52,11 @@ TEST(KeyframeAllocations, NoneAfterWarmUp) {
   // the keyframe estimator (matching against the keyframe, registration, new keyframes)
   // must not add any allocation to what refined needs.
   const long refined = perScan("refined"), keyframe = perScan("keyframe"),
-             surface = perScan("surface");
+             surface = perScan("surface"), keyframe_step = perScan("keyframe", true);
   std::cout << "[ info ] allocations over " << kCounted << " scans: refined " << refined << ", keyframe " << keyframe
-            << ", surface " << surface << "\n";
+            << ", surface " << surface << ", keyframe with keyframe_graph_step " << keyframe_step << "\n";
   EXPECT_LE(keyframe, refined);
+  EXPECT_LE(keyframe_step, refined);
   EXPECT_LE(surface, refined);  // surface points, submap and its index reuse their buffers
 }
 
