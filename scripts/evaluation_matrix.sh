@@ -48,7 +48,8 @@ mkdir -p "$out"
 # --- rows: label = odometry options -------------------------------------------------------
 # Every row names its front end: azimuth_peaks is on by default since 2026-11-27, and the rows
 # without "+peaks" are the paper's front end (one keypoint per row at the row angle). Every row
-# pins keyframe_graph, so a row means the same whatever the default ("+graph": window 6).
+# pins keyframe_graph, so a row means the same whatever the default ("+graph": window 6,
+# "+step": with keyframe_graph_step).
 declare -A row_args=(
   [rigid]="--estimator rigid --azimuth_peaks false"
   [mc]="--estimator mc --azimuth_peaks false"
@@ -56,17 +57,21 @@ declare -A row_args=(
   [refined]="--estimator refined --azimuth_peaks false"
   [keyframe]="--estimator keyframe --azimuth_peaks false --keyframe_graph 0"
   [keyframe+peaks]="--estimator keyframe --azimuth_peaks true --keyframe_graph 0"
-  [keyframe+peaks+graph]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6"
+  [keyframe+peaks+graph]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step false"
+  [keyframe+peaks+graph+step]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true"
   [surface]="--estimator surface --azimuth_peaks false --keyframe_graph 0"
   [surface+peaks]="--estimator surface --azimuth_peaks true --keyframe_graph 0"
 )
-all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks keyframe+peaks+graph surface surface+peaks)
+all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks keyframe+peaks+graph keyframe+peaks+graph+step surface surface+peaks)
 # Rows whose estimator this CLI does not know are left out (older builds).
 rows=()
+# Read once: `grep -q` closing the pipe early made `params` die of SIGPIPE, and with pipefail a
+# known estimator looked unknown (its row skipped).
+estimators="$("$bin" params 2>/dev/null | grep "^| *estimator |" || true)"
 for r in ${ROWS:-${all_rows[@]}}; do
   [[ -n "${row_args[$r]:-}" ]] || { echo "error: unknown row '$r' (rows: ${all_rows[*]})" >&2; exit 1; }
   est="$(sed -n 's/.*--estimator \([a-z_]*\).*/\1/p' <<< "${row_args[$r]}")"
-  if "$bin" params 2>/dev/null | grep -q "^| *estimator" && ! "$bin" params 2>/dev/null | grep "^| *estimator" | grep -q "$est"; then
+  if [[ -n "$estimators" && "$estimators" != *"$est"* ]]; then
     echo "note: row $r skipped (this build has no estimator '$est')" >&2; continue
   fi
   rows+=("$r")
