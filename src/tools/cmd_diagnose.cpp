@@ -127,6 +127,7 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   if (rep.holdout_scans > 0)
     std::cout << ", held out " << 100 * rep.worst_holdout_before << " % -> "
               << 100 * rep.worst_holdout_after << " % (" << rep.holdout_scans << " scans)";
+  if (opt.render_seeds > 1) std::cout << "; means over " << opt.render_seeds << " noise seeds";
   std::cout << "; report and sensor_fitted.json in " << dir << "\n";
 }
 
