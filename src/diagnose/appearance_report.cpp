@@ -166,6 +166,11 @@ nlohmann::json AppearanceReport::toJson() const {
       j["realism_bands"]["sim_before_max"] = bands(seeds_before.hi);
       j["realism_bands"]["sim_after_min"] = bands(seeds_after.lo);
       j["realism_bands"]["sim_after_max"] = bands(seeds_after.hi);
+      for (const auto* o : {&seeds_before, &seeds_after}) {  // each seed's, for spreads
+        nlohmann::json per = nlohmann::json::array();
+        for (const auto& s : o->per_seed) per.push_back(bands(s));
+        j["realism_bands"][o == &seeds_before ? "sim_before_per_seed" : "sim_after_per_seed"] = per;
+      }
     }
     if (!realism_holdout.name.empty()) j["realism_bands"]["recording_holdout"] = bands(realism_holdout);
     j["scene_dependent_not_fitted"] = nlohmann::json::array();
