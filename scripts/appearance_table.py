@@ -76,6 +76,14 @@ def main():
                 if part not in j["realism_bands"]:
                     cells.append("-")
                     continue
+                seeds = j.get("worst_band_gap_over_seeds", {})
+                key = "" if part == "recording_fit" else "holdout_"
+                if j.get("render_seeds", 1) > 1 and key + "after" in seeds:
+                    # --render-seeds N: the mean of each seed's worst gap [its range]
+                    b, a = seeds[key + "before"], seeds[key + "after"]
+                    cells.append(f"{100 * b['mean']:.0f} % [{100 * b['min']:.0f}-{100 * b['max']:.0f}] -> "
+                                 f"{100 * a['mean']:.0f} % [{100 * a['min']:.0f}-{100 * a['max']:.0f}]")
+                    continue
                 b, a = gaps(j, part, "sim_before"), gaps(j, part, "sim_after")
                 cells.append(f"{worst(b, far_only):.0f} % -> {worst(a, far_only):.0f} %")
             print(f"| {label}, {what} | " + " | ".join(cells) + " |")

@@ -8,7 +8,9 @@
 # Env: APPEARANCE_SCENE (the reference world of the fit, default city; city_facades: the city
 # with the far structure of real streets, docs/city_scene_far_structure.md); APPEARANCE_HOLD
 # (clutter: hold the clutter field at the start model's, i.e. off from the defaults, and fit the
-# sensor terms only; docs/diagnose_hold_clutter.md).
+# sensor terms only; docs/diagnose_hold_clutter.md); RENDER_SEEDS (noise seeds of the before /
+# after figures, --render-seeds: means with their range) and FIT_SEEDS (noise seeds of the
+# range-curve fit's objective, --appearance-fit-seeds; docs/diagnose_render_seeds.md).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="${1:?usage: scripts/calibrate_sensors.sh OUT [REALDATA]}"
@@ -21,7 +23,7 @@ mkdir -p "$out"
 run() {  # name, diagnose arguments...
   local name="$1"; shift
   echo "== $name" >&2
-  "$cli" diagnose "$@" --appearance-scene "${APPEARANCE_SCENE:-city}" ${APPEARANCE_HOLD:+--appearance-hold "$APPEARANCE_HOLD"} --out "$out/$name" > "$out/$name.log" 2>&1 \
+  "$cli" diagnose "$@" --appearance-scene "${APPEARANCE_SCENE:-city}" ${APPEARANCE_HOLD:+--appearance-hold "$APPEARANCE_HOLD"} ${RENDER_SEEDS:+--render-seeds "$RENDER_SEEDS"} ${FIT_SEEDS:+--appearance-fit-seeds "$FIT_SEEDS"} --out "$out/$name" > "$out/$name.log" 2>&1 \
     || { echo "$name: diagnose failed, see $out/$name.log" >&2; exit 1; }
   local fitted="$out/$name/appearance/sensor_fitted.json"
   cp "$fitted" "$root/config/sensors/$name.json.tmp"

@@ -170,6 +170,23 @@ sim::RealismStats realismOf(const SensorConfig& s, const sim::PhysicsConfig& phy
   return sim::computeRealism(renderReference(s, physics, opt, seed), name, sim::RealismOptions{});
 }
 
+sim::RealismOverSeeds realismOverSeedsOf(const SensorConfig& s, const sim::PhysicsConfig& physics,
+                                         const AppearanceOptions& opt,
+                                         const std::vector<uint64_t>& seeds,
+                                         const std::string& name) {
+  return sim::realismOverSeeds(
+      [&](uint64_t seed) { return renderReference(s, physics, opt, seed); }, seeds, name,
+      sim::RealismOptions{});
+}
+
+std::vector<uint64_t> fitSeeds(const AppearanceOptions& opt) {
+  return sim::renderSeeds(opt.seed, opt.fit_seeds, kFitSeedStride);
+}
+
+std::vector<uint64_t> reportSeeds(const AppearanceOptions& opt) {
+  return sim::renderSeeds(opt.seed + 1, opt.render_seeds);
+}
+
 namespace {
 
 // One Levenberg-Marquardt run from `start`, at most `iterations` steps; `misfit` gets the final
@@ -185,9 +202,12 @@ SensorConfig fitRangeCurvesOnce(const sim::RealismStats& real, const SensorConfi
     held[c] = isHeldParameter(opt, paramKey(t, c - t * kBands));
   }
   const Eigen::VectorXd target = logFigures(real, opt);
+  // The objective's figures: the mean over the fit's noise seeds (one render when fit_seeds is
+  // 1), the same seeds for every evaluation (common random numbers in the Jacobian).
+  const std::vector<uint64_t> seeds = fitSeeds(opt);
   auto eval = [&](const SensorConfig& s, Eigen::VectorXd& f) {
     try {
-      f = logFigures(realismOf(s, physics, opt, opt.seed, ""), opt);
+      f = logFigures(realismOverSeedsOf(s, physics, opt, seeds, "").mean, opt);
       return true;
     } catch (const std::invalid_argument&) {  // e.g. too many clutter scatterers
       return false;

@@ -71,21 +71,31 @@ void realismBeforeAfter(const std::vector<PolarScan>& real, const std::vector<Po
   sim::RealismOptions ro;
   rep.realism_real = sim::computeRealism(real, "recording, fit part", ro);
   if (!holdout.empty()) rep.realism_holdout = sim::computeRealism(holdout, "recording, held out", ro);
-  rep.realism_before =
-      sim::computeRealism(renderReference(rep.base, rep.base_physics, opt, opt.seed + 1), "sim, base model", ro);
-  rep.realism_after = sim::computeRealism(
-      renderReference(rep.fitted, rep.fitted_physics, opt, opt.seed + 1), "sim, fitted model", ro);
-  auto worst = [](const std::vector<std::pair<std::string, double>>& g) {
-    double w = 0;
-    for (const auto& x : g) w = std::max(w, x.second);
-    return w;
-  };
+  // Each simulated figure is the mean over the report's noise seeds (one render of seed + 1 by
+  // default), the worst gaps the mean of each seed's worst gap: a single render's worst gap moves
+  // by up to 15 points with the seed (docs/diagnose_render_seeds.md).
+  const std::vector<uint64_t> seeds = reportSeeds(opt);
+  const std::string over =
+      seeds.size() > 1 ? " (mean of " + std::to_string(seeds.size()) + " seeds)" : "";
+  rep.seeds_before = realismOverSeedsOf(rep.base, rep.base_physics, opt, seeds, "sim, base model" + over);
+  rep.seeds_after = realismOverSeedsOf(rep.fitted, rep.fitted_physics, opt, seeds, "sim, fitted model" + over);
+  rep.realism_before = rep.seeds_before.mean;
+  rep.realism_after = rep.seeds_after.mean;
   // Over the fitted figures only: a scene-dependent figure is reported on its own.
-  rep.worst_gap_before = worst(fittedBandGaps(rep.realism_before, rep.realism_real));
-  rep.worst_gap_after = worst(fittedBandGaps(rep.realism_after, rep.realism_real));
+  auto gaps = [](const sim::RealismStats& sim, const sim::RealismStats& real) {
+    std::vector<double> g;
+    for (const auto& x : fittedBandGaps(sim, real)) g.push_back(x.second);
+    return g;
+  };
+  rep.worst_before_seeds = sim::worstGapOverSeeds(rep.seeds_before, rep.realism_real, gaps);
+  rep.worst_after_seeds = sim::worstGapOverSeeds(rep.seeds_after, rep.realism_real, gaps);
+  rep.worst_gap_before = rep.worst_before_seeds.mean;
+  rep.worst_gap_after = rep.worst_after_seeds.mean;
   if (!holdout.empty()) {
-    rep.worst_holdout_before = worst(fittedBandGaps(rep.realism_before, rep.realism_holdout));
-    rep.worst_holdout_after = worst(fittedBandGaps(rep.realism_after, rep.realism_holdout));
+    rep.worst_holdout_before_seeds = sim::worstGapOverSeeds(rep.seeds_before, rep.realism_holdout, gaps);
+    rep.worst_holdout_after_seeds = sim::worstGapOverSeeds(rep.seeds_after, rep.realism_holdout, gaps);
+    rep.worst_holdout_before = rep.worst_holdout_before_seeds.mean;
+    rep.worst_holdout_after = rep.worst_holdout_after_seeds.mean;
     if (opt.holdout_scene_check) holdoutSceneCheck(real, holdout, opt, rep);
   }
 }
@@ -117,6 +127,17 @@ nlohmann::json AppearanceReport::toJson() const {
   j["worst_band_gap_after"] = worst_gap_after;
   j["worst_band_gap_holdout_before"] = worst_holdout_before;
   j["worst_band_gap_holdout_after"] = worst_holdout_after;
+  // Worst gaps as spreads over the render's noise seeds (the worst_band_gap_* above are means).
+  auto spread = [](const sim::SeedSpread& s) {
+    return nlohmann::json{{"mean", s.mean}, {"min", s.lo}, {"max", s.hi}, {"seeds", s.n}};
+  };
+  j["render_seeds"] = seeds_after.per_seed.size();
+  j["worst_band_gap_over_seeds"] = {{"before", spread(worst_before_seeds)},
+                                    {"after", spread(worst_after_seeds)}};
+  if (!realism_holdout.name.empty()) {
+    j["worst_band_gap_over_seeds"]["holdout_before"] = spread(worst_holdout_before_seeds);
+    j["worst_band_gap_over_seeds"]["holdout_after"] = spread(worst_holdout_after_seeds);
+  }
   j["fit_scans"] = fit_scans;
   j["holdout_scans"] = holdout_scans;
   j["holdout_split"] = holdout_split;
@@ -140,6 +161,17 @@ nlohmann::json AppearanceReport::toJson() const {
     j["realism_bands"] = {{"recording_fit", bands(realism_real)},
                           {"sim_before", bands(realism_before)},
                           {"sim_after", bands(realism_after)}};
+    if (seeds_after.per_seed.size() > 1) {  // each figure's range over the seeds
+      j["realism_bands"]["sim_before_min"] = bands(seeds_before.lo);
+      j["realism_bands"]["sim_before_max"] = bands(seeds_before.hi);
+      j["realism_bands"]["sim_after_min"] = bands(seeds_after.lo);
+      j["realism_bands"]["sim_after_max"] = bands(seeds_after.hi);
+      for (const auto* o : {&seeds_before, &seeds_after}) {  // each seed's, for spreads
+        nlohmann::json per = nlohmann::json::array();
+        for (const auto& s : o->per_seed) per.push_back(bands(s));
+        j["realism_bands"][o == &seeds_before ? "sim_before_per_seed" : "sim_after_per_seed"] = per;
+      }
+    }
     if (!realism_holdout.name.empty()) j["realism_bands"]["recording_holdout"] = bands(realism_holdout);
     j["scene_dependent_not_fitted"] = nlohmann::json::array();
     for (const auto& f : sceneDependentFigures())
@@ -199,17 +231,27 @@ std::string AppearanceReport::summaryMarkdown() const {
     if (!realism_holdout.name.empty()) cols.push_back(realism_holdout);
     cols.push_back(realism_before);
     cols.push_back(realism_after);
-    os << sim::formatRealismTable(cols);
+    std::vector<const sim::RealismOverSeeds*> ranges(cols.size(), nullptr);
+    ranges[cols.size() - 2] = &seeds_before;
+    ranges[cols.size() - 1] = &seeds_after;
+    os << sim::formatRealismTable(cols, ranges);
+    const size_t n_seeds = seeds_after.per_seed.size();
+    auto range = [&](const sim::SeedSpread& sp) {
+      return n_seeds > 1 ? " [" + fmt(100 * sp.lo, 3) + "-" + fmt(100 * sp.hi, 3) + "]" : std::string();
+    };
+    if (n_seeds > 1)
+      os << "\nSimulated columns: mean over " << n_seeds << " noise seeds [lowest-highest seed]; "
+            "each worst gap below is the mean of the seeds' worst gaps [their range].\n";
     os << "\nWorst per-band gap over the fitted figures (mean, q90, CA-CFAR, Cen2018 per band; "
           "scene-dependent ones below left out), fit part (" << fit_scans
-       << " scans): " << 100 * worst_gap_before << " % before, " << 100 * worst_gap_after
-       << " % after.";
+       << " scans): " << 100 * worst_gap_before << range(worst_before_seeds) << " % before, "
+       << 100 * worst_gap_after << range(worst_after_seeds) << " % after.";
     if (!realism_holdout.name.empty()) {
       std::string fig;
       const double halves = realHalvesDifference(&fig);
       os << " Held-out part (" << holdout_scans << " scans; split " << holdout_split << "): "
-         << 100 * worst_holdout_before << " % before, " << 100 * worst_holdout_after
-         << " % after. The real halves' own difference under this split: " << fmt(100 * halves, 3)
+         << 100 * worst_holdout_before << range(worst_holdout_before_seeds) << " % before, "
+         << 100 * worst_holdout_after << range(worst_holdout_after_seeds) << " % after. The real halves' own difference under this split: " << fmt(100 * halves, 3)
          << " % (" << fig << "), the floor of the held-out check.";
     }
     os << "\n";

@@ -1,11 +1,13 @@
 // Realism figures of polar scans (see realism.hpp).
 #include "spinradar/sim/realism.hpp"
+#include "spinradar/sim/realism_seeds.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <sstream>
+#include <stdexcept>
 
 #include "spinradar/features/detector.hpp"
 #include "spinradar/io/scan_io.hpp"
@@ -239,6 +241,13 @@ std::vector<std::pair<std::string, std::vector<PolarScan>>> loadRealSamples(
 }
 
 std::string formatRealismTable(const std::vector<RealismStats>& cols) {
+  return formatRealismTable(cols, std::vector<const RealismOverSeeds*>(cols.size(), nullptr));
+}
+
+std::string formatRealismTable(const std::vector<RealismStats>& cols,
+                               const std::vector<const RealismOverSeeds*>& spreads) {
+  if (spreads.size() != cols.size())
+    throw std::invalid_argument("formatRealismTable: one seed spread (or null) per column");
   std::ostringstream os;
   os << std::fixed;
   os << "| figure |";
@@ -248,12 +257,17 @@ std::string formatRealismTable(const std::vector<RealismStats>& cols) {
   os << "\n";
   auto row = [&](const char* label, auto get, int prec) {
     os << "| " << label << " |";
-    for (const auto& c : cols) {
-      double v = get(c);
-      if (v < 0)
+    for (size_t i = 0; i < cols.size(); ++i) {
+      const double v = get(cols[i]);
+      if (v < 0) {
         os << " - |";
-      else
-        os << ' ' << std::setprecision(prec) << v << " |";
+        continue;
+      }
+      os << ' ' << std::setprecision(prec) << v;
+      // A mean over noise seeds carries its range; one render (or equal seeds) prints as before.
+      if (const RealismOverSeeds* sp = spreads[i]; sp && get(sp->lo) != get(sp->hi))
+        os << " [" << get(sp->lo) << "-" << get(sp->hi) << "]";
+      os << " |";
     }
     os << "\n";
   };

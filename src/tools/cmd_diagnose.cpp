@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "cli_checks.hpp"
+#include "render_seeds_option.hpp"
 #include "command.hpp"
 #include "spinradar/core/safe_output.hpp"
 #include "spinradar/io/scan_folder.hpp"
@@ -33,6 +34,8 @@ struct DiagnoseArgs {
   bool no_resimulate = false, appearance = false;
   std::string sensor;  // base sensor model of the appearance stage (file or calibrated name)
   int appearance_scans = 4;
+  int render_seeds = 1;  // noise seeds of the realism figures before / after (means, ranges)
+  int fit_seeds = 1;     // noise seeds of the range-curve fit's objective (mean figures)
   int appearance_iterations = 4;  // Newton steps of the catalogue fit (AppearanceOptions::iterations)
   int curve_iterations = 16, curve_starts = 3;
   std::vector<double> curve_start_offset;  // noise dB, returns dB, log2 density (measurement)
@@ -83,6 +86,8 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   diagnose::AppearanceOptions opt;
   opt.scans = a.appearance_scans;
   opt.iterations = a.appearance_iterations;
+  opt.render_seeds = a.render_seeds;
+  opt.fit_seeds = a.fit_seeds;
   opt.curve_iterations = a.curve_iterations;
   opt.curve_starts = a.curve_starts;
   for (size_t i = 0; i < a.curve_start_offset.size() && i < 3; ++i) opt.curve_start_offset[i] = a.curve_start_offset[i];
@@ -122,6 +127,7 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   if (rep.holdout_scans > 0)
     std::cout << ", held out " << 100 * rep.worst_holdout_before << " % -> "
               << 100 * rep.worst_holdout_after << " % (" << rep.holdout_scans << " scans)";
+  if (opt.render_seeds > 1) std::cout << "; means over " << opt.render_seeds << " noise seeds";
   std::cout << "; report and sensor_fitted.json in " << dir << "\n";
 }
 
@@ -406,6 +412,13 @@ SPINRADAR_COMMAND(
                      "Newton steps of the catalogue fit (0: the --sensor file's global terms "
                      "are kept and only the range curves, leakage and glint are fitted)")
           ->check(CLI::Range(0, 20))
+          ->capture_default_str();
+      cli::addRenderSeedsOption(app, a->render_seeds, "the appearance stage's seed 12");
+      app.add_option("--appearance-fit-seeds", a->fit_seeds,
+                     "Noise seeds the per-band calibration's objective is averaged over (11, "
+                     "1011, ...; apart from the --render-seeds ones): a fit to one render's "
+                     "noise does not carry over (docs/diagnose_render_seeds.md)")
+          ->check(cli::inRange(1, 64))
           ->capture_default_str();
       app.add_option("--appearance-scans", a->appearance_scans,
                      "Re-simulated scans per evaluation in the appearance fit")

@@ -3,10 +3,12 @@
 #include <iostream>
 
 #include "cli_checks.hpp"
+#include "render_seeds_option.hpp"
 #include "command.hpp"
 #include "scene_comparison_options.hpp"
 #include "spinradar/io/scan_folder.hpp"
 #include "spinradar/sim/realism.hpp"
+#include "spinradar/sim/realism_seeds.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
 
@@ -16,6 +18,7 @@ struct RealismCmdOptions : spinradar::cli::SceneComparisonOptions {
   RealismCmdOptions() { scenes = {"city", "out_and_back", "tight_turns"}; }
   int scans = 8;
   uint64_t seed = 1;
+  int render_seeds = 1;  // noise seeds per scene: seed, seed + 1, ... (figures: mean [range])
   double min_range = 2.5, max_range = 100.0;
   bool no_detect = false;
 };
@@ -37,6 +40,8 @@ void runRealism(const RealismCmdOptions& o) {
   ro.max_range = o.max_range;
   ro.detect = !o.no_detect;
   std::vector<RealismStats> cols;
+  std::vector<RealismOverSeeds> spreads;  // per simulated scene
+  const std::vector<uint64_t> seeds = renderSeeds(o.seed, o.render_seeds);
   PhysicsConfig physics = cli::comparisonPhysics(o);
   SensorConfig sensor = o.sensor.empty() ? SensorConfig{} : SensorConfig::loadNamed(o.sensor);
   // The real samples are read first: a missing or corrupt one stops the command before the
@@ -52,12 +57,19 @@ void runRealism(const RealismCmdOptions& o) {
     real_cols = std::move(real);
   }
   for (const auto& name : o.scenes) {
-    Scene sc = builtinScene(name);
-    Simulator sim(sc.world, sc.trajectory, sensor, physics, o.seed);
-    std::vector<PolarScan> scans;
-    int total = sim.scanCount();
-    for (int i = 0; i < o.scans; ++i) scans.push_back(sim.renderScan(int((i + 0.5) * total / o.scans)));
-    cols.push_back(computeRealism(scans, name + " (sim)", ro));
+    const Scene sc = builtinScene(name);
+    auto render = [&](uint64_t seed) {
+      Simulator sim(sc.world, sc.trajectory, sensor, physics, seed);
+      std::vector<PolarScan> scans;
+      const int total = sim.scanCount();
+      for (int i = 0; i < o.scans; ++i) scans.push_back(sim.renderScan(int((i + 0.5) * total / o.scans)));
+      return scans;
+    };
+    const std::string label =
+        o.render_seeds == 1 ? name + " (sim)"
+                            : name + " (sim, mean of " + std::to_string(o.render_seeds) + " seeds)";
+    spreads.push_back(realismOverSeeds(render, seeds, label, ro));
+    cols.push_back(spreads.back().mean);
   }
   for (const auto& dir : o.recordings) {
     ScanFolder folder(dir);
@@ -67,7 +79,12 @@ void runRealism(const RealismCmdOptions& o) {
     cols.push_back(computeRealism(scans, dir, ro));
   }
   for (auto& [name, scans] : real_cols) cols.push_back(computeRealism(scans, name, ro));
-  std::cout << formatRealismTable(cols);
+  std::vector<const RealismOverSeeds*> ranges(cols.size(), nullptr);
+  for (size_t i = 0; i < spreads.size(); ++i) ranges[i] = &spreads[i];
+  std::cout << formatRealismTable(cols, ranges);
+  if (o.render_seeds > 1)
+    std::cout << "\nSimulated columns: mean over noise seeds " << o.seed << "-"
+              << o.seed + uint64_t(o.render_seeds - 1) << " [lowest-highest seed].";
   std::cout << "\nCells " << o.min_range << "-" << o.max_range
             << " m. * RADIATE is rescaled (not native ~1 dB/count): compare its texture only.\n";
 }
@@ -81,7 +98,8 @@ SPINRADAR_COMMAND("realism", "Compare simulated scans with the real samples (his
                     app.add_option("--scans", o->scans, "Scans per simulated scene")
                         ->capture_default_str()
                         ->check(spinradar::cli::atLeast(1));
-                    app.add_option("--seed", o->seed, "Noise seed")->capture_default_str();
+                    app.add_option("--seed", o->seed, "Noise seed (the first, with --render-seeds)")->capture_default_str();
+                    spinradar::cli::addRenderSeedsOption(app, o->render_seeds, "--seed");
                     app.add_option("--min-range", o->min_range, "m")
                         ->capture_default_str()
                         ->check(spinradar::cli::atLeast(0));

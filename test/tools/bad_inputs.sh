@@ -155,6 +155,14 @@ fail_row "diagnose --appearance-split blocks:7" "blocks:7.*must be an even" \
   "$bin" diagnose --recording "$in/rec" --out "$o/d" --appearance-split blocks:7
 fail_row "diagnose --max-scans 0" "--max-scans: 0 is not a count of scans" \
   "$bin" diagnose --recording "$in/rec" --out "$o/d" --max-scans 0
+fail_row "diagnose --render-seeds 0" "--render-seeds: 0 is below the minimum 1" \
+  "$bin" diagnose --recording "$in/rec" --out "$o/d" --render-seeds 0
+fail_row "diagnose --appearance-fit-seeds 65" "--appearance-fit-seeds: 65 is above the maximum 64" \
+  "$bin" diagnose --recording "$in/rec" --out "$o/d" --appearance-fit-seeds 65
+fail_row "realism --render-seeds 0" "--render-seeds: 0 is below the minimum 1" \
+  "$bin" realism --no-real --scene city --scans 1 --render-seeds 0
+fail_row "realism --render-seeds 2.5" "--render-seeds" \
+  "$bin" realism --no-real --scene city --scans 1 --render-seeds 2.5
 fail_row "localize --global-stride 0" "--global-stride: 0 is below the minimum 1" \
   "$bin" localize --map "$in/rec" --map-poses "$in/rec/trajectory.csv" --input "$in/rec" --out "$o/l.csv" --global-stride 0
 fail_row "pipeline range printed readably" "parameter 'zq' = -3 is outside \[0, [0-9.]+\]" \

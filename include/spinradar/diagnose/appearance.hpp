@@ -17,6 +17,7 @@
 #include "spinradar/diagnose/appearance_split.hpp"
 #include "spinradar/sim/physics.hpp"
 #include "spinradar/sim/realism.hpp"
+#include "spinradar/sim/realism_seeds.hpp"
 #include "spinradar/sim/scene.hpp"
 #include "spinradar/sim/sensor_config.hpp"
 
@@ -119,6 +120,14 @@ struct AppearanceOptions {
   std::shared_ptr<const sim::SensorConfig> gain_chain;
   int scans = 4;               ///< re-simulated scans per evaluation
   uint64_t seed = 11;
+  /// Noise seeds of the realism figures before / after (and the held-out part's): seed + 1 and
+  /// the next render_seeds - 1 (sim::renderSeeds); each figure is the mean over them and the
+  /// worst gaps are the mean of each seed's worst gap, with their range (CLI --render-seeds).
+  int render_seeds = 1;
+  /// Noise seeds the range-curve fit's objective is evaluated on: seed, seed + kFitSeedStride,
+  /// ...; its figures are the mean over them, so the fit cannot fit one render's noise (CLI
+  /// --appearance-fit-seeds; docs/diagnose_render_seeds.md). 1 = the single render of `seed`.
+  int fit_seeds = 1;
   int iterations = 4;          ///< Newton steps of the indirect-inference fit
   double z_min = 4.0;          ///< significance needed to name an effect
   /// Practical thresholds: a change smaller than these is negligible (1 dB for levels, 10 %
@@ -182,6 +191,11 @@ struct AppearanceOptions {
   /// scene from one of the sensor (detail::holdoutSceneCheck; needs realism and holdout).
   bool holdout_scene_check = true;
 };
+
+/// Spacing of the fit's noise seeds (AppearanceOptions::fit_seeds): the realism figures are
+/// rendered with seed + 1 ... seed + render_seeds, so fit seeds this far apart never meet them
+/// (render_seeds is at most 999) and the evaluation stays on noise the fit has not seen.
+constexpr uint64_t kFitSeedStride = 1000;
 
 /// The sensor keys of the textured clutter field, the one definition of what
 /// AppearanceOptions::hold_clutter holds.
@@ -256,6 +270,12 @@ struct AppearanceReport {
   /// Realism figures of the recording's fit part (realism_real) and held-out part, and of the
   /// reference scene re-simulated with the base and the fitted model (another noise seed).
   sim::RealismStats realism_real, realism_holdout, realism_before, realism_after;
+  /// The simulated realism figures per noise seed (opt.render_seeds of them; realism_before /
+  /// realism_after are their means) and the worst gaps as spreads over the seeds (worst_gap_*
+  /// and worst_holdout_* below are these spreads' means).
+  sim::RealismOverSeeds seeds_before, seeds_after;
+  sim::SeedSpread worst_before_seeds, worst_after_seeds, worst_holdout_before_seeds,
+      worst_holdout_after_seeds;
   /// Worst per-band realism gap (relative) over the fitted figures (scene-dependent ones left
   /// out), fit part and held-out part.
   double worst_gap_before = 0, worst_gap_after = 0;
@@ -317,6 +337,17 @@ AppearanceReport diagnoseAppearance(const std::vector<PolarScan>& real,
 /// out (rows masked through PolarScan::valid and zeroed; realism counts stay per full rotation).
 void splitHoldout(const std::vector<PolarScan>& scans, std::vector<PolarScan>& fit,
                   std::vector<PolarScan>& holdout);
+
+/// Realism figures of the reference scene rendered with `sensor` / `physics` for each of `seeds`.
+sim::RealismOverSeeds realismOverSeedsOf(const sim::SensorConfig& sensor,
+                                         const sim::PhysicsConfig& physics,
+                                         const AppearanceOptions& opt,
+                                         const std::vector<uint64_t>& seeds,
+                                         const std::string& name);
+/// The seeds the range-curve fit evaluates its objective on (AppearanceOptions::fit_seeds).
+std::vector<uint64_t> fitSeeds(const AppearanceOptions& opt);
+/// The seeds of the realism figures before / after (AppearanceOptions::render_seeds).
+std::vector<uint64_t> reportSeeds(const AppearanceOptions& opt);
 
 /// Realism figures of the reference scene rendered with `sensor` / `physics`.
 sim::RealismStats realismOf(const sim::SensorConfig& sensor, const sim::PhysicsConfig& physics,
