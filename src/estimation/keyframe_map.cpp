@@ -147,6 +147,7 @@ void KeyframeTracker::associateByProximity(const FeatureFrame& cur, const Eigen:
     in_.reserve(n + n / 2);
     dirs_.reserve(n + n / 2);
   }
+  if (cur_dirs_.size() != n) cacheDirections(cur);  // track() caches them; kept in step here too
   const double beta = config_.beta;
   // Keypoints of one stamp (a row; with azimuth peaks each has its own) share the motion
   // M = T_pred exp(tau xi): its top two rows, written out (Eigen's 3x3 temporaries stalled on
