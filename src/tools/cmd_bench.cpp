@@ -20,6 +20,7 @@
 #include "cli_checks.hpp"
 #include "command.hpp"
 #include "pipeline_options.hpp"
+#include "sorted_quantile.hpp"
 #include "spinradar/features/feature_extractor.hpp"
 #include "spinradar/features/matcher.hpp"
 #include "spinradar/estimation/odometry.hpp"
@@ -65,10 +66,9 @@ Stats stats(std::vector<double> v) {
   Stats s;
   if (v.empty()) return s;
   std::sort(v.begin(), v.end());
-  auto q = [&](double f) { return v[std::min(v.size() - 1, static_cast<size_t>(f * (v.size() - 1) + 0.5))]; };
   s.median = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-  s.p10 = q(0.1);
-  s.p90 = q(0.9);
+  s.p10 = cli::quantileOfSorted(v, 0.1);
+  s.p90 = cli::quantileOfSorted(v, 0.9);
   for (double x : v) s.mean += x;
   s.mean /= v.size();
   return s;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "sorted_quantile.hpp"
+
 namespace spinradar::cli {
 
 namespace {
@@ -15,7 +17,7 @@ Tail tailOf(std::vector<double> v) {
   Tail t;
   if (v.empty()) return t;
   std::sort(v.begin(), v.end());
-  t.p95 = v[std::min(v.size() - 1, static_cast<size_t>(0.95 * static_cast<double>(v.size() - 1) + 0.5))];
+  t.p95 = quantileOfSorted(v, 0.95);
   t.max = v.back();
   return t;
 }
