@@ -62,6 +62,7 @@ declare -A row_args=(
   [surface]="--estimator surface --azimuth_peaks false --keyframe_graph 0"
   [surface+peaks]="--estimator surface --azimuth_peaks true --keyframe_graph 0"
 )
+default_row="keyframe+peaks+graph+step"  # the row the CLI's defaults give (issue 19)
 all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks keyframe+peaks+graph keyframe+peaks+graph+step surface surface+peaks)
 # Rows whose estimator this CLI does not know are left out (older builds).
 rows=()
@@ -228,7 +229,8 @@ for path in sys.argv[2:4]:
             dl.append(math.hypot(full[b][0] - full[a][0], full[b][1] - full[a][1]) -
                       math.hypot(s[b][0] - s[a][0], s[b][1] - s[a][1]))
 rms = lambda v: math.sqrt(sum(x * x for x in v) / len(v)) if v else float("nan")
-out = [{"consistency": {"yaw_rms_deg": rms(dy), "length_rms_m": rms(dl), "pairs": len(dy)}}]
+out = [{"consistency": {"yaw_rms_deg": rms(dy), "length_rms_m": rms(dl), "pairs": len(dy),
+                         "yaw_diffs_deg": dy}}]  # per pair: the table's bootstrap interval
 json.dump(out, open(sys.argv[4] + ".tmp", "w"))
 os.replace(sys.argv[4] + ".tmp", sys.argv[4])
 PY
@@ -274,4 +276,5 @@ PY
   done
 done
 
-/usr/bin/env python3 "$root/scripts/evaluation_matrix_table.py" "$results" ${MERGE:-}
+# The default's losses with what resolves them (per seed, bootstrap over real pairs).
+/usr/bin/env python3 "$root/scripts/evaluation_matrix_table.py" --default "$default_row" "$results" ${MERGE:-}

@@ -85,3 +85,9 @@ if(EXISTS ${PROJECT_SOURCE_DIR}/src/tools/cmd_odometry.cpp)
     endif()
   endif()
 endif()
+
+# The evaluation matrix's list of the default's losses (per seed; bootstrap over real pairs)
+# against figures with a known answer (test/tools/matrix_table_losses.py).
+add_test(NAME cli_matrix_table_losses
+  COMMAND /usr/bin/python3 ${_tt}/matrix_table_losses.py
+          ${PROJECT_SOURCE_DIR}/scripts/evaluation_matrix_table.py)
