@@ -1,4 +1,4 @@
-// Cen2018 (real-time variant) and CA-CFAR keypoint detectors.
+// Cen2018 (real-time variant) keypoint detector, azimuth peaks (CA-CFAR: detector_cfar.cpp).
 //
 // Speed: the Cen2018 score needs a 51-tap Gaussian and two exponentials per bin, about 80 M
 // multiply-adds per 400 x 3768 scan if done everywhere. The score is bounded by
@@ -22,9 +22,13 @@
 #include <emmintrin.h>
 #endif
 
+#include "for_each_above.hpp"
+
 namespace spinradar {
 
 namespace {
+
+using detail::forEachAbove;
 
 constexpr int kKernelBits = 15;  // fixed-point Gaussian taps as int16 (pmaddwd), sum = 2^15
 constexpr float kNoiseFallback = 0.034f * 255.f;  // sigma when a row has no sample below its mean
@@ -62,31 +66,6 @@ int reflect101(int i, int n) {
   if (n == 1) return 0;
   while (i < 0 || i >= n) i = i < 0 ? -i : 2 * n - 2 - i;
   return i;
-}
-
-/// Calls f(j) for every j in [b0, b1] with row[j] > t, in increasing order.
-template <class F>
-void forEachAbove(const uint8_t* row, int b0, int b1, int t, F&& f) {
-  if (t >= 255) return;
-  int j = b0;
-  if (t < 0) {
-    for (; j <= b1; ++j) f(j);
-    return;
-  }
-#if defined(__SSE2__)
-  const __m128i tv = _mm_set1_epi8(static_cast<char>(t + 1));
-  for (; j + 16 <= b1 + 1; j += 16) {
-    const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + j));
-    // x >= t + 1  <=>  max(x, t + 1) == x (unsigned)
-    unsigned m = static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(x, tv), x)));
-    while (m) {
-      f(j + __builtin_ctz(m));
-      m &= m - 1;
-    }
-  }
-#endif
-  for (; j <= b1; ++j)
-    if (row[j] > t) f(j);
 }
 
 /// exp(x) for x <= 0 with ~2e-6 relative error; branch-free so that loops over it vectorize.
@@ -373,65 +352,6 @@ void Detector::detectCen2018(const PolarScan& scan, std::vector<Keypoint>& out) 
       last = j;
     }
     if (best >= 0) finishRun();
-  }
-}
-
-void Detector::detectCfar(const PolarScan& scan, std::vector<Keypoint>& out) {
-  out.clear();
-  if (scan.empty()) return;
-  if (scan.power.size() != size_t(scan.azimuths) * scan.bins || scan.azimuth.size() != size_t(scan.azimuths) ||
-      scan.stamp_ns.size() != size_t(scan.azimuths))
-    throw std::invalid_argument("Detector: inconsistent PolarScan sizes");
-  const int n = scan.bins, W = config_.cfar_window, G = config_.cfar_guard;
-  int b0, b1;
-  rangeWindow(scan, b0, b1);
-  if (b0 > b1) return;
-  cos_.resize(scan.azimuths);
-  sin_.resize(scan.azimuths);
-  prefix_.resize(size_t(n) + 1);
-  const float thr = static_cast<float>(config_.cfar_threshold);
-  const bool has_valid = scan.valid.size() == size_t(scan.azimuths);
-  int32_t* ps = prefix_.data();
-
-  hit_.resize(size_t(n));
-  mean_.resize(size_t(n));
-  uint8_t* hit = hit_.data();
-  float* mean = mean_.data();
-  for (int a = 0; a < scan.azimuths; ++a) {
-    if (has_valid && !scan.valid[a]) continue;
-    cos_[a] = std::cos(scan.azimuth[a]);
-    sin_[a] = std::sin(scan.azimuth[a]);
-    const uint8_t* row = scan.row(a);
-    ps[0] = 0;
-    for (int j = 0; j < n; ++j) ps[j + 1] = ps[j] + row[j];
-    // Interior bins have full windows on both sides: constant cell count, branch-free loop.
-    const int i0 = std::max(b0, G + W), i1 = std::min(b1, n - 1 - G - W);
-    auto general = [&](int j) {
-      const int l0 = std::max(0, j - G - W), l1 = std::max(0, j - G);          // [l0, l1)
-      const int r0 = std::min(n, j + G + 1), r1 = std::min(n, j + G + 1 + W);  // [r0, r1)
-      const int cnt = (l1 - l0) + (r1 - r0);
-      mean[j] = cnt > 0 ? float((ps[l1] - ps[l0]) + (ps[r1] - ps[r0])) / float(cnt) : 0.f;
-      hit[j] = cnt > 0 && float(row[j]) > thr * mean[j];
-    };
-    for (int j = b0; j <= std::min(b1, i0 - 1); ++j) general(j);
-    const float inv = 1.f / float(2 * W);
-    for (int j = i0; j <= i1; ++j) {
-      const int32_t sum = (ps[j - G] - ps[j - G - W]) + (ps[j + G + 1 + W] - ps[j + G + 1]);
-      mean[j] = float(sum) * inv;
-      hit[j] = float(row[j]) > thr * mean[j];
-    }
-    for (int j = std::max(b0, i1 + 1); j <= b1; ++j) general(j);
-    // One keypoint per run of hits, at its strongest bin (hits found 16 at a time).
-    int best = -1, last = -2;
-    forEachAbove(hit, b0, b1, 0, [&](int j) {
-      if (j != last + 1 && best >= 0) {
-        emit(scan, a, best, float(row[best]) - mean[best], out);
-        best = -1;
-      }
-      if (best < 0 || row[j] > row[best]) best = j;
-      last = j;
-    });
-    if (best >= 0) emit(scan, a, best, float(row[best]) - mean[best], out);
   }
 }
 
