@@ -1,6 +1,8 @@
 #pragma once
-// Internals shared by timing.cpp (stamps) and timing_findings.cpp (jitter, findings, advice).
+// Internals shared by timing.cpp (stamps), timing_findings.cpp (jitter, findings, advice) and
+// timing_report.cpp (JSON and Markdown).
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "spinradar/diagnose/timing.hpp"
@@ -23,6 +25,12 @@ int packetFirst(int index, int size, int phase);
 
 /// |z| of a chi^2 statistic (Wilson-Hilferty; does not underflow for huge statistics).
 double chi2ToZ(double chi2, int dof);
+
+/// Sub-nanosecond RMS is rounding of a perfect fit: print it as 0 (s -> us).
+inline double usRms(double s) { return s < 1e-9 ? 0.0 : s * 1e6; }
+
+/// "1 scan", "3 scans".
+inline std::string scansWord(int k) { return std::to_string(k) + (k == 1 ? " scan" : " scans"); }
 
 /// Findings from the stamp analysis (bursts, period variation), with their evidence.
 void addStampFindings(TimingReport& t, const TimingOptions& opt);
