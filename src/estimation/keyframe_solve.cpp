@@ -49,6 +49,55 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
   hold_floor_ = false;
   const double near_r = measure_floor ? kFloorNearFraction * max_floor_ / sa : 0.0;
   if (near_t_.capacity() < qx_.capacity()) near_t_.reserve(qx_.capacity());
+  // One match's residual and weights under (T, xi) (the same expressions in both passes
+  // below, so the same bits).
+  struct Terms {
+    Eigen::Vector2d pc, g, q, e;
+    Eigen::Matrix2d CT, CE, S, Si;
+    Eigen::Matrix<double, 6, 2> JtW;
+    Eigen::Matrix<double, 2, 6> J;
+  };
+  Eigen::Matrix3d E = Eigen::Matrix3d::Identity();
+  double E_tau = 0.0;
+  bool have_E = false;
+  // Up to the residual (for the gate); weights() completes the rest.
+  auto residual = [&](int m, const Eigen::Matrix3d& Tm, const Eigen::Vector3d& xim, Terms& t) {
+    const double ux = ux_[m], uy = uy_[m];
+    const double d = beta * (ux * xim(0) + uy * xim(1));
+    t.pc = Eigen::Vector2d(px_[m] + d * ux, py_[m] + d * uy);
+    if (!have_E || tau_[m] != E_tau) {  // matches of one azimuth row share tau
+      E = se2::exp(tau_[m] * xim);
+      E_tau = tau_[m];
+      have_E = true;
+    }
+    t.CT = Tm.topLeftCorner<2, 2>();
+    t.CE = E.topLeftCorner<2, 2>();
+    t.g = t.CE * t.pc + E.topRightCorner<2, 1>();
+    const Eigen::Vector2d qh = t.CT * t.g + Tm.topRightCorner<2, 1>();
+    t.q = Eigen::Vector2d(qx_[m], qy_[m]);
+    t.e = t.q - qh;
+    t.J.leftCols<3>() = -se2::odot2(qh);
+  };
+  auto weights = [&](int m, double fl, Terms& t) {
+    const double ux = ux_[m], uy = uy_[m];
+    Eigen::Matrix<double, 2, 3> D;
+    D << beta * ux * ux, beta * ux * uy, 0.0, beta * uy * ux, beta * uy * uy, 0.0;
+    t.J.rightCols<3>() = -t.CT * (tau_[m] * se2::odot2(t.g) + t.CE * D);
+    const Eigen::Matrix2d CC = t.CT * t.CE;
+    t.S = cartesianCovariance(t.q, sr, sa, fl) +
+          CC * cartesianCovariance(t.pc, sr, sa, fl) * CC.transpose();
+    t.Si = t.S.inverse();
+    t.JtW = t.J.transpose() * t.Si;
+  };
+  // Radial direction for the residual scales (cov_acc): between the two points' own.
+  auto radial = [](const Terms& t) {
+    const Eigen::Matrix2d CC = t.CT * t.CE;
+    return Eigen::Vector2d((t.q.normalized() + (CC * t.pc).normalized()).normalized());
+  };
+  Terms t;
+  Eigen::Matrix3d T_last = T;  ///< the last iteration's linearization point (see below)
+  Eigen::Vector3d xi_last = xi;
+  double floor_last = floor_m;
   for (int it = 0; it < kIterations + kFloorIterations; ++it) {
     // Gate: wide around the prediction first, narrower as the solution settles, at the
     // inlier threshold from iteration 4 on. With floor_gate, at least that multiple of the
@@ -64,9 +113,11 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
     const double thr = std::max(config_.inlier_threshold, config_.floor_gate * floor_m);
     const double gate = it < 2 ? kPredictionGate : it < 4 ? 2.0 * thr : thr;
     const double gate2 = gate * gate;
+    T_last = T;
+    xi_last = xi;
+    floor_last = floor_m;
+    have_E = false;  // xi moved: E is this iteration's
     A.setZero();
-    B.setZero();
-    dirs_.clear();
     near_t_.clear();
     double near_var = 0.0;  ///< sum of the near matches' configured tangential variances
     Vec6 b = Vec6::Zero();
@@ -78,59 +129,25 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
     b.head<3>() -= L.transpose() * Wp * rp;
     A.bottomRightCorner<3, 3>() += Wv;
     b.tail<3>() -= Wv * (xi - xi_prior);
-    const Eigen::Matrix2d CT = T.topLeftCorner<2, 2>();
-    const Eigen::Vector2d tT = T.topRightCorner<2, 1>();
-    const double vx = xi(0), vy = xi(1);
     chi2 = 0.0;
     cnt = 0;
-    Eigen::Matrix3d E = Eigen::Matrix3d::Identity();
-    double E_tau = 0.0;
-    bool have_E = false;
     for (int m = 0; m < n; ++m) {
       if (!regate && !in_[m]) continue;
-      const double ux = ux_[m], uy = uy_[m];
-      const double d = beta * (ux * vx + uy * vy);
-      const Eigen::Vector2d pc(px_[m] + d * ux, py_[m] + d * uy);
-      if (!have_E || tau_[m] != E_tau) {  // matches of one azimuth row share tau
-        E = se2::exp(tau_[m] * xi);
-        E_tau = tau_[m];
-        have_E = true;
-      }
-      const Eigen::Matrix2d CE = E.topLeftCorner<2, 2>();
-      const Eigen::Vector2d g = CE * pc + E.topRightCorner<2, 1>();
-      const Eigen::Vector2d qh = CT * g + tT;
-      const Eigen::Vector2d q(qx_[m], qy_[m]);
-      const Eigen::Vector2d e = q - qh;
-      if (regate) in_[m] = e.squaredNorm() <= gate2;
+      residual(m, T, xi, t);
+      if (regate) in_[m] = t.e.squaredNorm() <= gate2;
       if (!in_[m]) continue;
-      Eigen::Matrix<double, 2, 6> J;
-      J.leftCols<3>() = -se2::odot2(qh);
-      Eigen::Matrix<double, 2, 3> D;
-      D << beta * ux * ux, beta * ux * uy, 0.0, beta * uy * ux, beta * uy * uy, 0.0;
-      J.rightCols<3>() = -CT * (tau_[m] * se2::odot2(g) + CE * D);
-      const Eigen::Matrix2d CC = CT * CE;
-      const Eigen::Matrix2d S = cartesianCovariance(q, sr, sa, floor_m) +
-                                CC * cartesianCovariance(pc, sr, sa, floor_m) * CC.transpose();
-      const Eigen::Matrix2d Si = S.inverse();
-      const Eigen::Matrix<double, 6, 2> JtW = J.transpose() * Si;
-      A.noalias() += JtW * J;
-      b.noalias() -= JtW * e;
-      // Radial direction for the residual scales (cov_acc): between the two points' own.
-      const Eigen::Vector2d u = (q.normalized() + (CC * pc).normalized()).normalized();
-      dirs_.add(e, S, u.allFinite() ? u : Eigen::Vector2d::UnitX(), JtW);
-      const double r = q.norm();
-      if (r < near_r && u.allFinite()) {
-        near_t_.push_back(std::abs(u.x() * e.y() - u.y() * e.x()));
-        near_var += std::pow(std::max(r, 1.0) * sa, 2);
+      weights(m, floor_m, t);
+      A.noalias() += t.JtW * t.J;
+      b.noalias() -= t.JtW * t.e;
+      const double r = t.q.norm();
+      if (r < near_r) {  // near_r is 0 unless measure_floor
+        const Eigen::Vector2d u = radial(t);
+        if (u.allFinite()) {
+          near_t_.push_back(std::abs(u.x() * t.e.y() - u.y() * t.e.x()));
+          near_var += std::pow(std::max(r, 1.0) * sa, 2);
+        }
       }
-      // Acceleration within this scan moves the point by exp(tau^2/2 a) and within the
-      // keyframe's scan its map point by exp(tau_j^2/2 a_j): residual sensitivities.
-      const double tj = key_tau_m_[m];
-      Eigen::Matrix<double, 2, 6> Ja;
-      Ja.leftCols<3>() = -0.5 * tau_[m] * tau_[m] * CT * se2::odot2(g);
-      Ja.rightCols<3>() = 0.5 * tj * tj * se2::odot2(q);
-      B.noalias() += JtW * Ja;
-      chi2 += e.dot(Si * e);
+      chi2 += t.e.dot(t.Si * t.e);
       ++cnt;
     }
     if (cnt < min_inliers_) return false;
@@ -157,6 +174,26 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
       }
     }
     if (settled || it >= kIterations - 1) break;
+  }
+  // The residual scales (dirs_) and the acceleration sensitivities (B) of cov_acc are those of
+  // the last iteration only: one pass over its inliers at its linearization point, instead of
+  // in every iteration (the same values: issue 19, session 17).
+  B.setZero();
+  dirs_.clear();
+  have_E = false;
+  for (int m = 0; m < n; ++m) {
+    if (!in_[m]) continue;
+    residual(m, T_last, xi_last, t);
+    weights(m, floor_last, t);
+    const Eigen::Vector2d u = radial(t);
+    dirs_.add(t.e, t.S, u.allFinite() ? u : Eigen::Vector2d::UnitX(), t.JtW);
+    // Acceleration within this scan moves the point by exp(tau^2/2 a) and within the
+    // keyframe's scan its map point by exp(tau_j^2/2 a_j): residual sensitivities.
+    const double tj = key_tau_m_[m];
+    Eigen::Matrix<double, 2, 6> Ja;
+    Ja.leftCols<3>() = -0.5 * tau_[m] * tau_[m] * t.CT * se2::odot2(t.g);
+    Ja.rightCols<3>() = 0.5 * tj * tj * se2::odot2(t.q);
+    B.noalias() += t.JtW * Ja;
   }
   last_floor_ = floor_m;
   last_inliers_ = cnt;

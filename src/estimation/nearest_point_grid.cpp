@@ -7,6 +7,7 @@ namespace spinradar {
 
 namespace {
 constexpr int kMaxBands = 1 << 16;  // a wider spread of y widens the bands instead
+constexpr size_t kMaxDirectory = 1 << 18;  // bands x cells; a wider map widens the cells
 
 // Grows with headroom, so that the next, slightly larger map does not reallocate.
 template <typename T>
@@ -19,7 +20,8 @@ void fitSize(std::vector<T>& v, size_t n) {
 void NearestPointGrid::clear() {
   entries_.clear();
   band_start_.clear();
-  bands_ = 0;
+  cell_start_.clear();
+  bands_ = cells_ = 0;
 }
 
 // Monotone in y (all a query needs: the bands of [y - gate, y + gate] hold every point there).
@@ -30,12 +32,14 @@ int NearestPointGrid::bandOf(double y) const {
 
 void NearestPointGrid::build(const std::vector<Eigen::Vector2d>& pts) {
   clear();
-  double lo = 0.0, hi = 0.0;
+  double lo = 0.0, hi = 0.0, xlo = 0.0, xhi = 0.0;
   bool any = false;
   for (const Eigen::Vector2d& p : pts) {
     if (!std::isfinite(p.x()) || !std::isfinite(p.y())) continue;
     lo = any ? std::min(lo, p.y()) : p.y();
     hi = any ? std::max(hi, p.y()) : p.y();
+    xlo = any ? std::min(xlo, p.x()) : p.x();
+    xhi = any ? std::max(xhi, p.x()) : p.x();
     any = true;
   }
   if (!any) return;
@@ -67,20 +71,39 @@ void NearestPointGrid::build(const std::vector<Eigen::Vector2d>& pts) {
               [](const Entry& a, const Entry& c) {
                 return a.x < c.x || (a.x == c.x && a.index < c.index);
               });
+  // The x-cell directory: per band, where each cell's entries start.
+  x0_ = xlo;
+  const double max_cells = std::max(1.0, static_cast<double>(kMaxDirectory / bands_));
+  const double cell = std::max(kCell, (xhi - xlo) / std::max(1.0, max_cells - 1.0));
+  inv_cell_ = 1.0 / cell;
+  cells_ = std::min(static_cast<int>(std::floor((xhi - xlo) * inv_cell_)) + 1,
+                    static_cast<int>(max_cells));
+  fitSize(cell_start_, static_cast<size_t>(bands_) * static_cast<size_t>(cells_));
+  for (int b = 0; b < bands_; ++b) {
+    int e = band_start_[b];
+    const int end = band_start_[b + 1];
+    int* row = cell_start_.data() + static_cast<size_t>(b) * static_cast<size_t>(cells_);
+    for (int c = 0; c < cells_; ++c) {
+      while (e < end && cellOf(entries_[static_cast<size_t>(e)].x) < c) ++e;
+      row[c] = e;
+    }
+  }
 }
 
-// A binary search without branches on the data (conditional moves): the bands are short and
-// the queries random, so a branching search mispredicted on most steps (perf, Oxford model).
+int NearestPointGrid::cellOf(double x) const {
+  const double c = (x - x0_) * inv_cell_;
+  return !(c >= 0.0) ? 0 : c >= cells_ ? cells_ - 1 : static_cast<int>(c);
+}
+
+// From the directory's start of x's cell, on while below x: the same entry a binary search
+// over the band finds (entries before the start have a smaller cell, so a smaller x).
 const NearestPointGrid::Entry* NearestPointGrid::firstAtOrAfter(int b, double x) const {
-  const Entry* base = entries_.data() + band_start_[b];
-  size_t n = static_cast<size_t>(band_start_[b + 1] - band_start_[b]);
-  if (n == 0) return base;
-  while (n > 1) {
-    const size_t half = n / 2;
-    base = base[half - 1].x < x ? base + half : base;
-    n -= half;
-  }
-  return base + (base->x < x ? 1 : 0);
+  const Entry* it = entries_.data() +
+                    cell_start_[static_cast<size_t>(b) * static_cast<size_t>(cells_) +
+                                static_cast<size_t>(cellOf(x))];
+  const Entry* const last = entries_.data() + band_start_[b + 1];
+  while (it != last && it->x < x) ++it;
+  return it;
 }
 
 int NearestPointGrid::nearest(const Eigen::Vector2d& q, double gate) const {

@@ -87,3 +87,37 @@ TEST(NearestPointGrid, EmptyNonFiniteAndWideMaps) {
   EXPECT_EQ(grid.nearest({0.0, 0.0}, nan), -1);
   EXPECT_EQ(grid.nearest({0.0, -0.5}, 0.5), -1);  // at exactly the gate: not within it
 }
+
+// The x-cell directory (kCell): points on cell edges (integer x from the map's smallest),
+// queries just either side of an edge and outside the map in x, and a map wide in x and in y
+// at once, whose cells widen to keep the directory small: always the scan over every point.
+TEST(NearestPointGrid, CellEdgesAndWideMapsInX) {
+  NearestPointGrid grid;
+  std::vector<Eigen::Vector2d> pts;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 5; ++j) pts.emplace_back(-20.0 + i * NearestPointGrid::kCell, 0.25 * j);
+  grid.build(pts);
+  int found = 0, queries = 0;
+  for (int i = -2; i < 44; ++i)
+    for (const double dx : {-1e-12, 0.0, 1e-12, 0.29, 0.5})
+      for (const double gate : {0.3, 0.6, 1.5}) {
+        const Eigen::Vector2d q(-20.0 + i * NearestPointGrid::kCell + dx, 0.4);
+        const int want = bruteNearest(pts, q, gate);
+        ASSERT_EQ(grid.nearest(q, gate), want) << "x " << q.x() << " gate " << gate;
+        found += want >= 0;
+        ++queries;
+      }
+  EXPECT_GT(found, queries / 2);
+  // 2e5 m by 2e5 m with a dense cluster: bands x cells would be 4e10 at 1 m, so cells widen.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> wide(-1e5, 1e5), local(-5.0, 5.0);
+  std::vector<Eigen::Vector2d> spread;
+  for (int i = 0; i < 2000; ++i)
+    spread.emplace_back(i % 2 ? wide(rng) : local(rng), i % 2 ? wide(rng) : local(rng));
+  grid.build(spread);
+  for (int k = 0; k < 2000; ++k) {
+    const Eigen::Vector2d q(local(rng), local(rng));
+    for (const double gate : {0.3, 1.5})
+      ASSERT_EQ(grid.nearest(q, gate), bruteNearest(spread, q, gate)) << "query " << k;
+  }
+}

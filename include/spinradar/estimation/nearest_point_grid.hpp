@@ -4,7 +4,9 @@
 // Oxford model's clutter it held hundreds of points per query, and at keyframe switches
 // (keyframe_graph) the search was the largest single cost (issue 19, thirteenth round).
 // The answer is the strip's, to the bit: the nearest point strictly within the gate, ties to
-// the smaller (x, index).
+// the smaller (x, index). Each band's start of an x range is found through a directory of
+// x cells (no binary search: at keyframe_graph switches that search was a third of the
+// proximity association, issue 19, session 17).
 #pragma once
 
 #include <vector>
@@ -24,6 +26,7 @@ class NearestPointGrid {
   int nearest(const Eigen::Vector2d& q, double gate) const;
 
   static constexpr double kBand = 1.0;  ///< m, band height (gates are 0.3-1.5 m)
+  static constexpr double kCell = 1.0;  ///< m, x cell width of the directory (at least)
 
  private:
   struct Entry {
@@ -31,12 +34,17 @@ class NearestPointGrid {
     int index;
   };
   int bandOf(double y) const;
+  int cellOf(double x) const;  ///< monotone in x, clamped to [0, cells_ - 1]
   const Entry* firstAtOrAfter(int band, double x) const;  ///< first entry of band with x >= x
   std::vector<Entry> entries_;   ///< band by band, each band sorted by (x, index)
   std::vector<int> band_start_;  ///< entries_ of band b: [band_start_[b], band_start_[b + 1])
   std::vector<int> band_of_;     ///< build scratch: each point's band
+  /// Band b's first entry with cellOf(x) >= c: cell_start_[b * cells_ + c]. Every entry before
+  /// it has x below any x of cell c (cellOf is monotone), so a search starts there.
+  std::vector<int> cell_start_;
   double y0_ = 0.0, inv_band_ = 1.0 / kBand;
-  int bands_ = 0;
+  double x0_ = 0.0, inv_cell_ = 1.0 / kCell;
+  int bands_ = 0, cells_ = 0;
 };
 
 }  // namespace spinradar
