@@ -41,8 +41,14 @@ constexpr int kGapFigures = 4;  // the first four are the realism figures the ga
 // depend on the returns' shape; on Boreas-RT's own scene, 4.4 cm bins, 12522 cells at 50-100 m
 // with a 2.7-bin sigma and 1906 with 3.6, against the recording's 5460, while the isolated
 // targets the catalogue fits it to kept it at 2.6)
-constexpr int kGlobals = 4;
-constexpr int kRows = kBands * kPerBand, kCols = kTypes * kBands + kGlobals;
+// and the returns' far slope as the gain at twice the last node (AppearanceOptions::fit_far_slope)
+constexpr int kGlobals = 5;
+constexpr double kFarSlopeDecades = 0.30103;  // log10(2): the slope's parameter is its gain at 142 m
+// Two more rows: the mean and q90 count beyond 100 m (RealismStats::beyond_*), with fit_far_slope
+// only (the mean alone is mostly receiver noise there and moved the 71 m noise node instead):
+// the band figures end at 100 m, where a slope beyond 71 m has barely begun (-40 dB/decade moves
+// the 50-100 m mean by 3 %), and the 71 m nodes would take up what it does there.
+constexpr int kRows = kBands * kPerBand + 2, kCols = kTypes * kBands + kGlobals;
 
 double* node(SensorConfig& s, int type, int j) {
   static double SensorConfig::*const f[kTypes][kBands] = {
@@ -64,7 +70,8 @@ double getParam(const SensorConfig& s, int type, int j) {
     return j == 0   ? s.noise_texture_db
            : j == 1 ? s.clutter_rcs_db
            : j == 2 ? 10 * std::log2(s.power_scale)
-                    : 10 * std::log2(s.range_psf_sigma_bins);
+           : j == 3 ? 10 * std::log2(s.range_psf_sigma_bins)
+                    : s.return_far_slope_db_per_decade * kFarSlopeDecades;
   if (type == 0) return *node(m, 0, j);
   if (type == 1) return *node(m, 0, j) + *node(m, 1, j);
   return std::log2(std::max(*node(m, 2, j), 1.0 / 64));
@@ -79,6 +86,8 @@ void setParam(SensorConfig& s, int type, int j, double p) {
       s.power_scale = std::clamp(std::exp2(p / 10), 0.5, 3.0);
     else if (j == 3 && std::abs(p - 10 * std::log2(s.range_psf_sigma_bins)) > 1e-9)  // moved
       s.range_psf_sigma_bins = std::clamp(std::exp2(p / 10), 0.3, 20.0);
+    else if (j == 4 && std::abs(p - s.return_far_slope_db_per_decade * kFarSlopeDecades) > 1e-9)
+      s.return_far_slope_db_per_decade = std::clamp(p / kFarSlopeDecades, -80.0, 20.0);
   } else if (type == 2) {
     *node(s, 2, j) = std::clamp(std::exp2(p), 1.0 / 64, 20.0);
   } else if (type == 1) {
@@ -95,7 +104,8 @@ void setParam(SensorConfig& s, int type, int j, double p) {
 std::string paramKey(int type, int j) {
   static const char* const nodes[kBands] = {"5m", "16m", "35m", "71m"};
   static const char* const globals[kGlobals] = {"noise_texture_db", "clutter_rcs_db", "power_scale",
-                                                "range_psf_sigma_bins"};
+                                                "range_psf_sigma_bins",
+                                                "return_far_slope_db_per_decade"};
   if (type == kTypes) return globals[j];
   static const char* const curves[kTypes] = {"stc_curve_db_", "return_gain_db_",
                                              "clutter_density_x_"};
@@ -120,6 +130,9 @@ Eigen::VectorXd logFigures(const sim::RealismStats& st, const AppearanceOptions&
     for (int i = 0; i < kPerBand; ++i)
       if (isSceneDependent(k, kFigureNames[i])) v[kPerBand * k + i] = 0;
   }
+  const bool beyond = opt.fit_far_slope && st.beyond_mean >= 0;
+  v[kRows - 2] = beyond ? std::log(1 + st.beyond_mean) : 0.0;
+  v[kRows - 1] = beyond ? std::log(1 + st.beyond_q90) : 0.0;
   return v;
 }
 
@@ -247,6 +260,7 @@ SensorConfig fitRangeCurvesOnce(const sim::RealismStats& real, const SensorConfi
       const int t = std::min(c / kBands, kTypes), j = c - t * kBands;
       if (t == kTypes && j == 2 && cur.native_codes != 0) continue;  // column stays zero
       if (t == kTypes && j == 3 && !opt.fit_spread_bands) continue;  // opt-in
+      if (t == kTypes && j == 4 && !opt.fit_far_slope) continue;     // opt-in
       if (t == 1 && opt.hold_gain_chain) continue;  // the returns' level is held (combined)
       if (held[c]) continue;                          // e.g. the clutter field (hold_clutter)
       SensorConfig s = cur;

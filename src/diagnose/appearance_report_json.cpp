@@ -59,6 +59,9 @@ nlohmann::json AppearanceReport::toJson() const {
     // Not a gap figure: the noise side, which tells receiver noise from weak clutter.
     b["floor"] = std::vector<double>(s.band_floor, s.band_floor + 4);
     b["zero"] = std::vector<double>(s.band_zero, s.band_zero + 4);
+    // Nor these: beyond 100 m, the far slope's evidence (-1: the scans end at 100 m).
+    b["beyond_mean"] = s.beyond_mean;
+    b["beyond_q90"] = s.beyond_q90;
     return b;
   };
   if (!realism_real.name.empty()) {

@@ -83,6 +83,7 @@ RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::stri
   std::vector<std::vector<double>> band_hist(4, std::vector<double>(256, 0.0));
   double cacfar[4] = {0, 0, 0, 0}, cen_band[4] = {0, 0, 0, 0};
   double band_sum[4] = {0, 0, 0, 0}, band_n[4] = {0, 0, 0, 0};
+  std::vector<double> beyond_hist(256, 0.0);
   const double* band_edge = kBandEdges;
   Corr az, rs, rl;
   double det_cen = 0, det_cfar = 0;
@@ -101,6 +102,7 @@ RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::stri
       if (!s.valid.empty() && !s.valid[a]) continue;
       const uint8_t* row = s.row(a);
       const uint8_t* next = s.row((a + 1) % s.azimuths);
+      for (int b = b1 + 1; b < s.bins; ++b) beyond_hist[row[b]] += 1;
       for (int b = b0; b <= b1; ++b) {
         hist[row[b]] += 1;
         double r = s.rangeOfBin(b);
@@ -188,6 +190,15 @@ RealismStats computeRealism(const std::vector<PolarScan>& scans, const std::stri
   for (int v = 40; v < 256; ++v) bright += hist[v];
   st.bright_fraction = bright / total;
   for (int k = 0; k < 4; ++k) st.band_mean[k] = band_n[k] > 0 ? band_sum[k] / band_n[k] : 0;
+  double beyond_n = 0, beyond_sum = 0;
+  for (int v = 0; v < 256; ++v) beyond_n += beyond_hist[v], beyond_sum += v * beyond_hist[v];
+  double beyond_c = 0;
+  for (int v = 0; v < 256 && beyond_n > 0; ++v)
+    if ((beyond_c += beyond_hist[v]) >= 0.9 * beyond_n) {
+      st.beyond_mean = beyond_sum / beyond_n;
+      st.beyond_q90 = v;
+      break;
+    }
   st.azimuth_corr = az.value();
   st.range_corr_short = rs.value();
   st.range_corr_long = rl.value();

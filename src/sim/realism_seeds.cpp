@@ -15,7 +15,8 @@ template <class F>
 void forEachFigure(RealismStats& s, F&& f) {
   for (double* v : {&s.zero_fraction, &s.mean, &s.q50, &s.q90, &s.q99, &s.q999, &s.max,
                     &s.bright_fraction, &s.azimuth_corr, &s.range_corr_short, &s.range_corr_long,
-                    &s.detections_cen, &s.detections_cfar, &s.cacfar})
+                    &s.detections_cen, &s.detections_cfar, &s.cacfar, &s.beyond_mean,
+                    &s.beyond_q90})
     f(*v);
   for (double* a : {s.band_mean, s.band_q90, s.band_cacfar, s.band_cen, s.band_floor, s.band_zero})
     for (int k = 0; k < 4; ++k) f(a[k]);

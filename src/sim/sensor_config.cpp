@@ -51,7 +51,10 @@ double SensorConfig::stcCurveDb(double r) const {
   return curveAt(r, stc_curve_db_5m, stc_curve_db_16m, stc_curve_db_35m, stc_curve_db_71m);
 }
 double SensorConfig::returnGainDb(double r) const {
-  return curveAt(r, return_gain_db_5m, return_gain_db_16m, return_gain_db_35m, return_gain_db_71m);
+  const double g = curveAt(r, return_gain_db_5m, return_gain_db_16m, return_gain_db_35m, return_gain_db_71m);
+  // Beyond the last node the curve is flat unless the far slope is set (0: exactly as before).
+  if (return_far_slope_db_per_decade == 0 || r <= kCurveNodes[3]) return g;
+  return g + return_far_slope_db_per_decade * std::log10(r / kCurveNodes[3]);
 }
 double SensorConfig::clutterDensityX(double r) const {
   return curveAt(r, clutter_density_x_5m, clutter_density_x_16m, clutter_density_x_35m,
@@ -63,7 +66,8 @@ double SensorConfig::clutterDensityXMax() const {
 }
 bool SensorConfig::hasRangeCurves() const {
   for (double v : {stc_curve_db_5m, stc_curve_db_16m, stc_curve_db_35m, stc_curve_db_71m,
-                   return_gain_db_5m, return_gain_db_16m, return_gain_db_35m, return_gain_db_71m})
+                   return_gain_db_5m, return_gain_db_16m, return_gain_db_35m, return_gain_db_71m,
+                   return_far_slope_db_per_decade})
     if (v != 0) return true;
   for (double v : {clutter_density_x_5m, clutter_density_x_16m, clutter_density_x_35m,
                    clutter_density_x_71m})

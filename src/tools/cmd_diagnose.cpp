@@ -51,6 +51,7 @@ struct DiagnoseArgs {
   bool scene_subbin = false;
   bool scene_clean = false;  // own scene by CLEAN instead of one scatterer per local maximum
   bool fit_spread = false;
+  bool fit_far_slope = false;
   std::string hold;  // held parameter group of the appearance fit ("" or "clutter")
   std::string holdout_split = diagnose::kDefaultHoldoutSplit;
   bool split_survey = false;  // only measure the real halves' difference under candidate splits
@@ -102,6 +103,7 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   opt.scene_refine_passes = a.scene_refine;
   opt.scene_range_subbin = a.scene_subbin;
   opt.fit_spread_bands = a.fit_spread;
+  opt.fit_far_slope = a.fit_far_slope;
   opt.hold_clutter = a.hold == "clutter";
   opt.holdout_split = a.holdout_split;
   if (!a.gain_chain.empty()) {
@@ -399,6 +401,9 @@ SPINRADAR_COMMAND(
       app.add_flag("--appearance-fit-spread", a->fit_spread,
                    "Let the per-band figures move the range spread too (CA-CFAR cells follow the "
                    "returns' width; docs/diagnose_scene.md)");
+      app.add_flag("--appearance-fit-far-slope", a->fit_far_slope,
+                   "Let the per-band figures move the returns' slope beyond the last curve node "
+                   "(71 m; sensor return_far_slope_db_per_decade; docs/diagnose_far_band.md)");
       app.add_option("--appearance-hold", a->hold,
                      "Hold a parameter group at the --sensor file's values and fit the rest: "
                      "clutter (clutter_density, clutter_density_x_*, clutter_rcs_db, "

@@ -178,6 +178,11 @@ struct AppearanceOptions {
   /// RADIATE's held out 23 -> 20 %, but Oxford's combined 14 -> 20 % and MulRan's 20 -> 25 %
   /// (docs/diagnose_scene.md).
   bool fit_spread_bands = false;
+  /// Let the per-band figures move the returns' far slope (sensor return_far_slope_db_per_decade,
+  /// a global of the range-curve fit): beyond the last curve node (71 m) the curves are flat, so
+  /// without it the 71 m node sets 50-100 m and everything beyond alike (Oxford: the far band's
+  /// mean and its q90 then only rise together; docs/diagnose_far_band.md). Off by default.
+  bool fit_far_slope = false;
   /// Fit the glint terms (per-scan shift of the scattering centres across and along the beam,
   /// per-row azimuth jitter: physics glint_across, glint_along, azimuth_jitter, carried by the
   /// fitted sensor) to the spread of returns matched between consecutive scans

@@ -44,6 +44,11 @@ struct RealismStats {
   /// recording 30-40 %; docs/diagnose_chirps.md).
   double band_zero[4] = {0, 0, 0, 0};
   double cacfar = 0;              ///< plain CA-CFAR cells per scan, all bands
+  /// Mean count of the cells beyond max_range to the last bin (Oxford: 100-165 m), -1 when the
+  /// scans end there: not a realism gap, the evidence of the returns' far slope
+  /// (AppearanceOptions::fit_far_slope; docs/diagnose_far_band.md).
+  double beyond_mean = -1;
+  double beyond_q90 = -1;  ///< q90 count of the same cells (the returns' side; the mean: noise too)
 };
 
 /// Range bands of the per-band figures (m).

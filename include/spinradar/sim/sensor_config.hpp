@@ -57,6 +57,7 @@
   X(double, return_gain_db_16m, 0.0, -40.0, 40.0, "dB", "Gain of returns, not noise, at 16 m") \
   X(double, return_gain_db_35m, 0.0, -40.0, 40.0, "dB", "Gain of returns, not noise, at 35 m") \
   X(double, return_gain_db_71m, 0.0, -40.0, 40.0, "dB", "Gain of returns, not noise, at 71 m") \
+  X(double, return_far_slope_db_per_decade, 0.0, -80.0, 20.0, "dB/dec", "Gain of returns, not noise, beyond the last curve node (71 m) per decade of range (low-grazing ground clutter and the elevation pattern fall off there; 0 = flat, as the curves are outside their nodes)") \
   X(double, clutter_density_x_5m, 1.0, 0.0, 20.0, "", "Textured clutter density at 5 m relative to clutter_density (grazing-angle visibility)") \
   X(double, clutter_density_x_16m, 1.0, 0.0, 20.0, "", "Textured clutter density at 16 m relative to clutter_density") \
   X(double, clutter_density_x_35m, 1.0, 0.0, 20.0, "", "Textured clutter density at 35 m relative to clutter_density") \
