@@ -170,6 +170,13 @@ void Detector::rebuildKernel() {
   cand_factor_ = candidateFactor(config_.zq);
 }
 
+// Both detectors are public entry points: each checks the scan it is given.
+void Detector::requireConsistent(const PolarScan& scan) {
+  if (scan.power.size() != size_t(scan.azimuths) * scan.bins || scan.azimuth.size() != size_t(scan.azimuths) ||
+      scan.stamp_ns.size() != size_t(scan.azimuths))
+    throw std::invalid_argument("Detector: inconsistent PolarScan sizes");
+}
+
 void Detector::detect(const PolarScan& scan, std::vector<Keypoint>& out) {
   if (config_.detector == "cfar")
     detectCfar(scan, out);
@@ -248,9 +255,7 @@ void Detector::emit(const PolarScan& scan, int a, double bin, float score,
 void Detector::detectCen2018(const PolarScan& scan, std::vector<Keypoint>& out) {
   out.clear();
   if (scan.empty()) return;
-  if (scan.power.size() != size_t(scan.azimuths) * scan.bins || scan.azimuth.size() != size_t(scan.azimuths) ||
-      scan.stamp_ns.size() != size_t(scan.azimuths))
-    throw std::invalid_argument("Detector: inconsistent PolarScan sizes");
+  requireConsistent(scan);
   const int n = scan.bins, R = radius_;
   int b0, b1;
   rangeWindow(scan, b0, b1);

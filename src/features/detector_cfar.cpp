@@ -2,7 +2,6 @@
 // over cfar_threshold times the mean of the training cells on both sides.
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 #include "for_each_above.hpp"
 #include "spinradar/features/detector.hpp"
@@ -14,9 +13,7 @@ using detail::forEachAbove;
 void Detector::detectCfar(const PolarScan& scan, std::vector<Keypoint>& out) {
   out.clear();
   if (scan.empty()) return;
-  if (scan.power.size() != size_t(scan.azimuths) * scan.bins || scan.azimuth.size() != size_t(scan.azimuths) ||
-      scan.stamp_ns.size() != size_t(scan.azimuths))
-    throw std::invalid_argument("Detector: inconsistent PolarScan sizes");
+  requireConsistent(scan);
   const int n = scan.bins, W = config_.cfar_window, G = config_.cfar_guard;
   int b0, b1;
   rangeWindow(scan, b0, b1);

@@ -57,6 +57,8 @@ class Detector {
   void detectCfar(const PolarScan& scan, std::vector<Keypoint>& out);
 
  private:
+  /// Throws std::invalid_argument when the scan's arrays disagree with its size.
+  static void requireConsistent(const PolarScan& scan);
   void emit(const PolarScan& scan, int a, double bin, float score, std::vector<Keypoint>& out) const;
   void rangeWindow(const PolarScan& scan, int& b0, int& b1) const;
   /// Azimuthal peaks only (DetectorConfig::azimuth_peaks).
