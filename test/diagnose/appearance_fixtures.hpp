@@ -1,10 +1,15 @@
 #pragma once
 // Shared setup of the appearance-stage tests: a sensor reaching all four range bands and
 // options for quick renders.
+#include "../../src/diagnose/appearance_detail.hpp"
 #include "spinradar/diagnose/appearance.hpp"
+#include "spinradar/sim/realism.hpp"
 #include "spinradar/sim/sensor_config.hpp"
 
+#include <algorithm>
+#include <memory>
 #include <string>
+#include <vector>
 
 namespace spinradar::diagnose::testing {
 
@@ -50,6 +55,26 @@ inline AppearanceOptions catalogueOnlyOptions() {
   o.holdout = false;
   o.curve_iterations = 0;
   return o;
+}
+
+/// The held-out check as the appearance stage runs it after a fit that gave `fitted` back
+/// exactly (the sensor given, not fitted): realism of both parts, the fitted sensor rendered
+/// in the fit part's own scene, the worst held-out gap and detail::holdoutSceneCheck on top.
+inline AppearanceReport holdoutCheck(const std::vector<PolarScan>& fit,
+                                     const std::vector<PolarScan>& holdout,
+                                     const sim::SensorConfig& fitted) {
+  AppearanceOptions opt = quickAppearanceOptions();
+  opt.scene = "recording";
+  opt.scene_scans = std::make_shared<const std::vector<PolarScan>>(fit);
+  AppearanceReport rep;
+  rep.fitted = fitted;
+  rep.realism_real = sim::computeRealism(fit, "fit part");
+  rep.realism_holdout = sim::computeRealism(holdout, "held out");
+  rep.realism_after = sim::computeRealism(renderReference(fitted, {}, opt, opt.seed + 1), "after");
+  for (const auto& [name, gap] : fittedBandGaps(rep.realism_after, rep.realism_holdout))
+    rep.worst_holdout_after = std::max(rep.worst_holdout_after, gap);
+  detail::holdoutSceneCheck(fit, holdout, opt, rep);
+  return rep;
 }
 
 }  // namespace spinradar::diagnose::testing

@@ -31,24 +31,6 @@ std::vector<PolarScan> render(const std::string& scene, const sim::SensorConfig&
   return out;
 }
 
-// The report as the appearance stage leaves it when the fit gave `fitted` back exactly, and the
-// held-out check on top.
-AppearanceReport check(const std::vector<PolarScan>& fit, const std::vector<PolarScan>& holdout,
-                       const sim::SensorConfig& fitted) {
-  AppearanceOptions opt = testing::quickAppearanceOptions();
-  opt.scene = "recording";
-  opt.scene_scans = std::make_shared<const std::vector<PolarScan>>(fit);
-  AppearanceReport rep;
-  rep.fitted = fitted;
-  rep.realism_real = sim::computeRealism(fit, "fit part");
-  rep.realism_holdout = sim::computeRealism(holdout, "held out");
-  rep.realism_after = sim::computeRealism(renderReference(fitted, {}, opt, opt.seed + 1), "after");
-  for (const auto& [name, gap] : fittedBandGaps(rep.realism_after, rep.realism_holdout))
-    rep.worst_holdout_after = std::max(rep.worst_holdout_after, gap);
-  detail::holdoutSceneCheck(fit, holdout, opt, rep);
-  return rep;
-}
-
 void print(const char* what, const AppearanceReport& rep) {
   std::cout << what << ": worst held-out gap " << rep.worst_holdout_after
             << ", with the held-out part's own scene " << rep.worst_holdout_scene
@@ -65,7 +47,7 @@ TEST(AppearanceHoldout, OtherStretchHeldOutIsTheScene) {
   const sim::SensorConfig s = testing::hundredMetreSensor();
   const auto fit = render("out_and_back", s, {300, 600}, 3);
   const auto holdout = render("out_and_back", s, {450, 750}, 4);
-  const AppearanceReport rep = check(fit, holdout, s);
+  const AppearanceReport rep = testing::holdoutCheck(fit, holdout, s);
   print("other stretch", rep);
   int scene = 0, halves = 0;
   for (const auto& f : rep.held_out_figures) {
@@ -89,7 +71,7 @@ TEST(AppearanceHoldout, NoisierHeldOutReceiverIsTheModel) {
   noisy.noise_floor_db += 6.0;
   const auto fit = render("out_and_back", s, {300, 600}, 3);
   const auto holdout = render("out_and_back", noisy, {310, 610}, 4);
-  const AppearanceReport rep = check(fit, holdout, s);
+  const AppearanceReport rep = testing::holdoutCheck(fit, holdout, s);
   print("noisier held-out receiver", rep);
   int model = 0;
   for (const auto& f : rep.held_out_figures)
@@ -112,7 +94,7 @@ TEST(AppearanceHoldout, NullCarriesOver) {
   const sim::SensorConfig s = testing::hundredMetreSensor();
   const auto fit = render("out_and_back", s, {300, 600}, 3);
   const auto holdout = render("out_and_back", s, {310, 610}, 4);
-  const AppearanceReport rep = check(fit, holdout, s);
+  const AppearanceReport rep = testing::holdoutCheck(fit, holdout, s);
   print("null", rep);
   for (const auto& f : rep.held_out_figures)
     if (f.gap_fit <= 0.15) {

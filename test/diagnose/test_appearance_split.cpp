@@ -137,23 +137,6 @@ TEST(AppearanceSplit, AlongDriveDriftShowsInContiguousSplitOnly) {
   EXPECT_NE(chooseHoldoutSplit(rec).name(), "contiguous");
 }
 
-// The held-out check as the appearance stage runs it, the sensor given (not fitted).
-AppearanceReport check(const std::vector<PolarScan>& fit, const std::vector<PolarScan>& holdout,
-                       const sim::SensorConfig& fitted) {
-  AppearanceOptions opt = testing::quickAppearanceOptions();
-  opt.scene = "recording";
-  opt.scene_scans = std::make_shared<const std::vector<PolarScan>>(fit);
-  AppearanceReport rep;
-  rep.fitted = fitted;
-  rep.realism_real = sim::computeRealism(fit, "fit part");
-  rep.realism_holdout = sim::computeRealism(holdout, "held out");
-  rep.realism_after = sim::computeRealism(renderReference(fitted, {}, opt, opt.seed + 1), "after");
-  for (const auto& [name, gap] : fittedBandGaps(rep.realism_after, rep.realism_holdout))
-    rep.worst_holdout_after = std::max(rep.worst_holdout_after, gap);
-  detail::holdoutSceneCheck(fit, holdout, opt, rep);
-  return rep;
-}
-
 // The held-out rows come from a receiver 6 dB noisier: interleaved blocks still see it as the
 // model, and now (the parts share every sector) every sector's background moves alike.
 TEST(AppearanceSplit, SensorChangeInHeldOutRowsIsStillTheModel) {
@@ -167,7 +150,7 @@ TEST(AppearanceSplit, SensorChangeInHeldOutRowsIsStillTheModel) {
       if ((r / 20) % 2) std::copy(loud[i].row(r), loud[i].row(r) + rec[i].bins, rec[i].row(r));
   std::vector<PolarScan> fit, held;
   splitHoldout(rec, fit, held, parseHoldoutSplit("blocks:20"));
-  const AppearanceReport rep = check(fit, held, s);
+  const AppearanceReport rep = testing::holdoutCheck(fit, held, s);
   int model = 0;
   for (const auto& f : rep.held_out_figures) {
     std::cout << "  " << f.name << ": gap fit " << f.gap_fit << " held out " << f.gap_holdout
