@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "spinradar/core/lie.hpp"
+
 namespace spinradar::diagnose {
 namespace {
 
@@ -29,8 +31,6 @@ bool segmentsCross(double ax, double ay, double bx, double by, const sim::Wall& 
   const double d4 = cross(w.x2 - w.x1, w.y2 - w.y1, bx - w.x1, by - w.y1);
   return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0));
 }
-
-double wrapPi(double a) { return std::remainder(a, 2.0 * M_PI); }
 
 }  // namespace
 
@@ -121,7 +121,7 @@ std::vector<TargetView> targetViews(int scan_index, const PolarScan& scan,
            oj += dir) {
         const TargetView& vb = views[order[oj]];
         if (std::fabs(va.pred.range - vb.pred.range) >= win) break;
-        if (std::fabs(wrapPi(va.pred.azimuth - vb.pred.azimuth)) < 2.0 * va.gate.azimuth &&
+        if (std::fabs(se2::wrapAngle(va.pred.azimuth - vb.pred.azimuth)) < 2.0 * va.gate.azimuth &&
             world.targets[vb.target].rcs > ta.rcs - opt.dominance_db) {
           keep[a] = false;
           break;
@@ -152,7 +152,7 @@ std::vector<TargetView> targetViews(int scan_index, const PolarScan& scan,
         const double dx = w.x1 + u * (w.x2 - w.x1) - s.x, dy = w.y1 + u * (w.y2 - w.y1) - s.y;
         const double xs = c * dx + sn * dy, ys = -sn * dx + c * dy;
         if (std::fabs(std::hypot(xs, ys) - va.pred.true_range) < half_r &&
-            std::fabs(wrapPi(std::atan2(-ys, xs) - bearing)) < half_a)
+            std::fabs(se2::wrapAngle(std::atan2(-ys, xs) - bearing)) < half_a)
           keep[a] = false;
       }
     }

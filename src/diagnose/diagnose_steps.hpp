@@ -7,12 +7,11 @@
 #include <functional>
 #include <vector>
 
+#include "spinradar/core/lie.hpp"
 #include "spinradar/diagnose/diagnose.hpp"
 #include "spinradar/sim/simulator.hpp"
 
 namespace spinradar::diagnose::detail {
-
-inline double wrapPi(double a) { return std::remainder(a, 2.0 * M_PI); }
 
 // Precision a parabolic peak fit can claim: 1/50 of a bin, 1/50 of a row.
 inline double rangeNoiseFloor(const sim::SensorConfig& s) { return 0.02 * s.range_resolution; }

@@ -52,14 +52,14 @@ Association associateObservations(const DiagnoseInput& in, const DiagnoseOptions
         (q == 0 ? moved.x : moved.y) += hp;
         const Prediction pq = predictTarget(moved, geo, in.trajectory, in.base, opt.conventions);
         o.tr[q] = (pq.range - v.pred.range) / hp;
-        o.taz[q] = wrapPi(pq.azimuth - v.pred.azimuth) / hp;
+        o.taz[q] = se2::wrapAngle(pq.azimuth - v.pred.azimuth) / hp;
       }
       for (Effect e : cands) {
         const double h = effectStep(e);
         const Prediction pe = predictTarget(tg, geo, in.trajectory, withEffect(in.base, e, h),
                                             opt.conventions);
         o.dr[static_cast<int>(e)] = (pe.range - v.pred.range) / h;
-        o.daz[static_cast<int>(e)] = wrapPi(pe.azimuth - v.pred.azimuth) / h;
+        o.daz[static_cast<int>(e)] = se2::wrapAngle(pe.azimuth - v.pred.azimuth) / h;
         if (map) {
           // The mapped position moves with the parameter too (it was placed under it).
           const Eigen::Vector2d& dp = map->dpos[v.target][static_cast<int>(e)];
@@ -73,7 +73,7 @@ Association associateObservations(const DiagnoseInput& in, const DiagnoseOptions
         const Prediction pq =
             predictTarget(tg, geo, in.trajectory, in.base, opt.conventions, deltas[q]);
         o.nr[q] = (pq.range - v.pred.range) / steps[q];
-        o.naz[q] = wrapPi(pq.azimuth - v.pred.azimuth) / steps[q];
+        o.naz[q] = se2::wrapAngle(pq.azimuth - v.pred.azimuth) / steps[q];
       }
       cand_obs.push_back(o);
       gates.push_back(v.gate);
@@ -85,7 +85,7 @@ Association associateObservations(const DiagnoseInput& in, const DiagnoseOptions
       if (!sim_meas[i].ok) continue;
       Observation o = cand_obs[i];
       o.e_r = o.real_r - sim_meas[i].range;
-      o.e_az = wrapPi(o.real_az - sim_meas[i].azimuth);
+      o.e_az = se2::wrapAngle(o.real_az - sim_meas[i].azimuth);
       obs_of_scan[k].push_back(static_cast<int>(rep.obs.size()));
       rep.obs.push_back(o);
       gate_of_obs.push_back(gates[i]);

@@ -139,7 +139,7 @@ void resimulateWithEffects(const DiagnoseInput& in, const DiagnoseOptions& opt,
           if (!m[q].ok) continue;
           const int i = obs_of_scan[k][q];
           t.er_j[i] = rep.obs[i].real_r - m[q].range;
-          t.ea_j[i] = wrapPi(rep.obs[i].real_az - m[q].azimuth);
+          t.ea_j[i] = se2::wrapAngle(rep.obs[i].real_az - m[q].azimuth);
         }
       }
       // Observations the re-simulation lost count with their base residual (conservative);

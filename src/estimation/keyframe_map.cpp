@@ -12,12 +12,6 @@
 
 namespace spinradar {
 
-namespace {
-
-double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
-
-}  // namespace
-
 double KeyframeTracker::rowQuantization(const FeatureFrame& f) {
   int same_row = 0, same_angle = 0;
   double step = 0.0;
@@ -27,7 +21,7 @@ double KeyframeTracker::rowQuantization(const FeatureFrame& f) {
       ++same_row;
       same_angle += k[i].azimuth == k[i - 1].azimuth;
     } else if (step == 0.0 && k[i].azimuth_index == k[i - 1].azimuth_index + 1) {
-      step = std::abs(wrapAngle(k[i].azimuth - k[i - 1].azimuth));
+      step = std::abs(se2::wrapAngle(k[i].azimuth - k[i - 1].azimuth));
     }
   }
   return same_row >= 20 && same_angle >= 0.9 * same_row ? step : 0.0;

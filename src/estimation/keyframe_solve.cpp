@@ -15,10 +15,6 @@
 
 namespace spinradar {
 
-namespace {
-double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
-}  // namespace
-
 bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3d& C_prior,
                             const Eigen::Vector3d& xi_prior, const Eigen::Matrix3d& Cxi_prior,
                             const Eigen::Matrix3d& Cxi_honest, Eigen::Matrix3d& T,
@@ -122,7 +118,7 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
     double near_var = 0.0;  ///< sum of the near matches' configured tangential variances
     Vec6 b = Vec6::Zero();
     Eigen::Vector3d rp = se2::toXyYaw(T) - prior_pose;
-    rp(2) = wrapAngle(rp(2));
+    rp(2) = se2::wrapAngle(rp(2));
     const Eigen::Matrix3d L = se2::leftPerturbationToXyYaw(T);
     Ap = L.transpose() * Wp * L;
     A.topLeftCorner<3, 3>() += Ap;

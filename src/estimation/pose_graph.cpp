@@ -12,13 +12,13 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 
+#include "spinradar/core/lie.hpp"
+
 namespace spinradar {
 
 namespace {
 
 constexpr int kIterations = 5;
-
-double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
 /// Residual of edge e at x and its Jacobians with respect to nodes a and b.
 Eigen::Vector3d residual(const std::vector<Eigen::Vector3d>& x, const PoseGraphEdge& e,
@@ -30,7 +30,7 @@ Eigen::Vector3d residual(const std::vector<Eigen::Vector3d>& x, const PoseGraphE
   Ri << ca, sa, -sa, ca;
   const Eigen::Vector2d d = Ri * (xb.head<2>() - xa.head<2>());
   Eigen::Vector3d r;
-  r << d - e.z.head<2>(), wrap(xb(2) - xa(2) - e.z(2));
+  r << d - e.z.head<2>(), se2::wrapAngle(xb(2) - xa(2) - e.z(2));
   Jb.setZero();
   Jb.topLeftCorner<2, 2>() = Ri;
   Jb(2, 2) = 1.0;

@@ -7,14 +7,14 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "spinradar/core/lie.hpp"
+
 namespace spinradar {
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadToDeg = 180.0 / kPi;
-
-double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
 double yawOf(const Eigen::Matrix3d& T) { return std::atan2(T(1, 0), T(0, 0)); }
 
@@ -62,7 +62,7 @@ bool interpolatePose(const std::vector<PoseRecord>& traj, double t, PoseRecord& 
   out.t = t;
   out.x = a.x + f * (b.x - a.x);
   out.y = a.y + f * (b.y - a.y);
-  out.yaw = wrapAngle(a.yaw + f * wrapAngle(b.yaw - a.yaw));
+  out.yaw = se2::wrapAngle(a.yaw + f * se2::wrapAngle(b.yaw - a.yaw));
   out.vx = a.vx + f * (b.vx - a.vx);
   out.vy = a.vy + f * (b.vy - a.vy);
   out.wz = a.wz + f * (b.wz - a.wz);

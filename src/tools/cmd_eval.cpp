@@ -153,7 +153,7 @@ nlohmann::json neesSummary(std::vector<double> v) {
 
 double nees(const Eigen::Matrix3d& est, const Eigen::Matrix3d& truth, const Eigen::Matrix3d& C) {
   Eigen::Vector3d e = se2::toXyYaw(est) - se2::toXyYaw(truth);
-  e(2) = std::remainder(e(2), 2.0 * M_PI);
+  e(2) = se2::wrapAngle(e(2));
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(C);
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return -1.0;
   return e.dot(ldlt.solve(e));

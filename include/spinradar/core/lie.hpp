@@ -20,6 +20,9 @@ constexpr double kSmallAngle = 1e-3;
 // ----------------------------------------------------------------------------------------
 namespace se2 {
 
+/// The angle a wrapped into [-pi, pi] (IEEE remainder: exact, no rounding).
+inline double wrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }
+
 using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 
