@@ -347,7 +347,13 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   if (registered && key_inliers_ == 0) key_inliers_ = last_inliers_;
   const double dist = T_jk.topRightCorner<2, 1>().norm();
   const double ang = std::abs(std::atan2(T_jk(1, 0), T_jk(0, 0)));
-  const bool renew = (!still && !registered) || weak || dist > kKeyframeDistance || ang > kKeyframeAngle ||
+  // Where one scan alone turns further than keyframe_angle, every scan would become a keyframe
+  // and hand on a registration made under the turn's largest distortion: keyframe_angle_fast.
+  const double scan_turn = std::abs(xi_k(2)) * c / kMidScan;
+  const double switch_angle = scan_turn > config_.keyframe_angle
+                                  ? std::max(config_.keyframe_angle, config_.keyframe_angle_fast)
+                                  : config_.keyframe_angle;
+  const bool renew = (!still && !registered) || weak || dist > kKeyframeDistance || ang > switch_angle ||
                      (registered && last_inliers_ < kInlierRatio * key_inliers_);
   prev_c_ = c;
   prev_pair_xi_ = pair.velocity;

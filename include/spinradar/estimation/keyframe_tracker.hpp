@@ -129,7 +129,6 @@ class KeyframeTracker {
   int graphEdgesDropped() const { return graph_edges_dropped_; }
 
   static constexpr double kKeyframeDistance = 10.0;  ///< m, new keyframe beyond this
-  static constexpr double kKeyframeAngle = 0.35;     ///< rad
   static constexpr int kMinInliers = 30;
   /// A scan whose descriptors found kMinWeakInliers..kMinInliers-1 inliers where the
   /// proximity fallback does not run is registered with them and becomes the keyframe
