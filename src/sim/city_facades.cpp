@@ -48,7 +48,7 @@ void addFacadeDetail(World& w, uint64_t variant, int grid, double pitch, const F
         for (double u = uni(0, p.furniture_max_m); u < grid * pitch;
              u += uni(p.furniture_min_m, p.furniture_max_m)) {
           const double m = std::fmod(u, pitch);
-          if (m < 9 || m > pitch - 9) continue;
+          if (m < p.junction_clear_m || m > pitch - p.junction_clear_m) continue;
           const double off = side * uni(p.furniture_off_min_m, p.furniture_off_max_m);
           const double rcs = uni(p.furniture_rcs_min_db, p.furniture_rcs_max_db);
           if (axis == 0)

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "spinradar/sim/city_facades.hpp"
+#include "spinradar/sim/city_layout.hpp"
 #include "render_model.hpp"
 
 namespace spinradar::sim {
@@ -142,18 +143,17 @@ class Route {
 
 // ---- city ---------------------------------------------------------------------------------
 
-constexpr int kCityGrid = 6;         ///< blocks per side
-constexpr double kCityPitch = 64.0;  ///< m, street centre line to centre line
-
-Scene city(uint64_t variant, double t0) {
+// The layout's numbers are in city_layout.hpp (its defaults are this scene).
+Scene city(uint64_t variant, double t0, const detail::CityLayout& L = {}) {
   Scene sc;
   sc.name = "city";
   sc.description =
       "7x7 street grid (64 m pitch, 14 m streets) with facades, poles, parked and moving cars; "
       "a ~5 min route with 12 turns at 5 m/s and straights at 10-15 m/s";
   Rng rng(0xC1770000ull + variant);
-  const int G = kCityGrid;
-  const double P = kCityPitch, half_street = 7.0;
+  const int G = L.grid;
+  const double P = L.pitch_m, half_street = L.half_street_m;
+  const double s = half_street - 7.0;  // kerb-side objects move out with the kerb (0: the city)
   World& w = sc.world;
   // Buildings: each block split into 1-3 buildings along a random axis, with setbacks.
   for (int i = 0; i < G; ++i)
@@ -166,8 +166,10 @@ Scene city(uint64_t variant, double t0) {
       double pos = lo;
       for (int k = 0; k < n; ++k) {
         double end = k == n - 1 ? hi : pos + (hi - lo) / n;
-        double gap = k == n - 1 ? 0.0 : uni(rng, 2.0, 5.0);
-        double sb[4] = {uni(rng, 0, 2.5), uni(rng, 0, 2.5), uni(rng, 0, 2.5), uni(rng, 0, 2.5)};
+        // A gap at most half a building's share keeps every building a box (the city's never is).
+        double gap = k == n - 1 ? 0.0 : std::min(uni(rng, L.gap_min_m, L.gap_max_m), 0.5 * (hi - lo) / n);
+        const double sm = L.setback_max_m;
+        double sb[4] = {uni(rng, 0, sm), uni(rng, 0, sm), uni(rng, 0, sm), uni(rng, 0, sm)};
         double bx0 = along_x ? pos : x0 + sb[0], bx1 = along_x ? end - gap : x1 - sb[1];
         double by0 = along_x ? y0 + sb[2] : pos, by1 = along_x ? y1 - sb[3] : end - gap;
         double rpm = uni(rng, 0.0, 8.0);
@@ -180,8 +182,8 @@ Scene city(uint64_t variant, double t0) {
   for (int k = 0; k <= G; ++k)
     for (int side = -1; side <= 1; side += 2)
       for (double u = uni(rng, 0, 10); u < G * P; u += uni(rng, 15, 35)) {
-        if (std::fmod(u, P) < 9 || std::fmod(u, P) > P - 9) continue;  // keep junctions clear
-        double off = side * uni(rng, 6.0, 6.8);
+        if (std::fmod(u, P) < 9 + s || std::fmod(u, P) > P - 9 - s) continue;  // keep junctions clear
+        double off = side * uni(rng, 6.0 + s, 6.8 + s);
         double rcs = uni(rng, 5, 18);
         w.targets.push_back({u, k * P + off, rcs, 0, 0});   // along x-streets
         w.targets.push_back({k * P + off, u, rcs, 0, 0});   // along y-streets
@@ -191,8 +193,8 @@ Scene city(uint64_t variant, double t0) {
     for (int side = -1; side <= 1; side += 2)
       for (double u = 10; u < G * P; u += 6.0) {
         double m = std::fmod(u, P);
-        if (m < 10 || m > P - 12 || rng.uniform() > 0.35) continue;
-        double off = side * 4.8;
+        if (m < 10 + s || m > P - 12 - s || rng.uniform() > 0.35) continue;
+        double off = side * (4.8 + s);
         double rpm = uni(rng, 6, 12);
         addBox(w, u + 2.2, k * P + off, 4.4, 1.8, 0.0, rpm);
         addBox(w, k * P + off, u + 2.2, 4.4, 1.8, M_PI / 2, rpm);
@@ -222,7 +224,7 @@ Scene city(uint64_t variant, double t0) {
     double dx = std::min(mx, P - mx), dy = std::min(my, P - my);
     bool near_x = dx < half_street + 2.5, near_y = dy < half_street + 2.5;
     if (!near_x && !near_y) return false;
-    if ((near_x && dx < 4.5) || (near_y && dy < 4.5)) return false;
+    if ((near_x && dx < 4.5 + s) || (near_y && dy < 4.5 + s)) return false;
     return true;
   };
   addClutter(w, rng, -40, -40, G * P + 40, G * P + 40, 0.3, verge);
@@ -230,8 +232,8 @@ Scene city(uint64_t variant, double t0) {
     for (int side = -1; side <= 1; side += 2)
       for (double u = uni(rng, 0, 20); u < G * P; u += uni(rng, 15, 45)) {
         double m = std::fmod(u, P);
-        if (m < 10 || m > P - 10) continue;
-        double off = side * uni(rng, 7.5, 9.0);
+        if (m < 10 + s || m > P - 10 - s) continue;
+        double off = side * uni(rng, 7.5 + s, 9.0 + s);
         if (rng.uniform() < 0.5)
           addTree(w, rng, u, k * P + off, uni(rng, 1.0, 2.5));
         else
@@ -369,7 +371,7 @@ Scene tightTurns(uint64_t variant, double t0) {
 }  // namespace
 
 std::vector<std::string> builtinSceneNames() {
-  return {"city", "city_facades", "out_and_back", "tight_turns"};
+  return {"city", "city_facades", "city_open", "out_and_back", "tight_turns"};
 }
 
 Scene builtinScene(const std::string& name, uint64_t variant, double t0) {
@@ -379,7 +381,22 @@ Scene builtinScene(const std::string& name, uint64_t variant, double t0) {
     sc.name = name;
     sc.description += "; facade detail (window bays, doors, balconies, corners) and street "
                       "furniture as point scatterers";
-    detail::addFacadeDetail(sc.world, variant, kCityGrid, kCityPitch);
+    const detail::CityLayout l;
+    detail::addFacadeDetail(sc.world, variant, l.grid, l.pitch_m);
+    return sc;
+  }
+  if (name == "city_open") {  // city_facades' detail on a more open street grid (city_layout.hpp)
+    const detail::CityLayout l = detail::openCityLayout();
+    Scene sc = city(variant, t0, l);
+    sc.name = name;
+    sc.description = "open street grid (" + std::to_string(int(l.pitch_m)) + " m pitch, " +
+                     std::to_string(int(2 * l.half_street_m)) +
+                     " m streets, buildings set back further and with wider gaps) with facade detail and "
+                     "street furniture; the city's route, furniture and traffic";
+    detail::FacadeDetail fd;
+    const double s = l.half_street_m - 7.0;  // the furniture stays at the kerb
+    fd.furniture_off_min_m += s, fd.furniture_off_max_m += s, fd.junction_clear_m += s;
+    detail::addFacadeDetail(sc.world, variant, l.grid, l.pitch_m, fd);
     return sc;
   }
   if (name == "out_and_back") return outAndBack(variant, t0);

@@ -47,6 +47,7 @@ struct FacadeDetail {
   double furniture_off_max_m = 6.4;
   double furniture_rcs_min_db = -5.0;  ///< dBsm, uniform
   double furniture_rcs_max_db = 12.0;
+  double junction_clear_m = 9.0;   ///< no furniture this close to a crossing's centre line
 };
 
 /// Adds the facade detail to `w` (the city world of `grid` x `grid` blocks of `pitch` m): details
