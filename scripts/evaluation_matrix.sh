@@ -59,11 +59,13 @@ declare -A row_args=(
   [keyframe+peaks]="--estimator keyframe --azimuth_peaks true --keyframe_graph 0"
   [keyframe+peaks+graph]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step false"
   [keyframe+peaks+graph+step]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true"
+  # The turn-heading option (docs/sensor_columns/round16_turn_heading.md) on the default row.
+  [default+start_rate0.25]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --start_rate_pair_weight 0.25"
   [surface]="--estimator surface --azimuth_peaks false --keyframe_graph 0"
   [surface+peaks]="--estimator surface --azimuth_peaks true --keyframe_graph 0"
 )
 default_row="keyframe+peaks+graph+step"  # the row the CLI's defaults give (issue 19)
-all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks keyframe+peaks+graph keyframe+peaks+graph+step surface surface+peaks)
+all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks keyframe+peaks+graph keyframe+peaks+graph+step default+start_rate0.25 surface surface+peaks)
 # Rows whose estimator this CLI does not know are left out (older builds).
 rows=()
 # Read once: `grep -q` closing the pipe early made `params` die of SIGPIPE, and with pipefail a

@@ -321,7 +321,6 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   Eigen::Matrix3d C_jk_acc, Cxi_k_acc;  // T_jk's [x, y, yaw] and xi_k's (keyframe_fusion)
   const Eigen::Matrix<double, 6, 6> Cd_acc = withModelErrors(cov_acc);
   {
-    const Eigen::Matrix<double, 6, 6>& Cd = Cd_acc;
     const Eigen::Matrix3d M_j = T_wj_ * E_j;
     const Eigen::Matrix3d T_mk = T_jk * se2::exp(-c * xi_k);  // this scan's start, from M_j
     Eigen::Matrix<double, 3, 6> J;
@@ -333,13 +332,14 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     // in C_rel). Without it a keyframe taken at a failed turn scan (tight_turns layout 1:
     // 19 deg off, key_xi_cov_ holding the yaw-rate step) left the chain at NEES 76.
     const Eigen::Matrix3d Ckey = key_c_ * key_c_ * key_xi_cov_;
-    const Eigen::Matrix3d C_mk = Lk * (J * Cd * J.transpose() + Ckey) * Lk.transpose();
+    const Eigen::Matrix3d C_mk = Lk * (J * Cd_acc * J.transpose() + Ckey) * Lk.transpose();
     Eigen::Matrix3d T_unused;
     se2::compoundXyYaw(M_j, P_jm_, T_mk, C_mk, T_unused, P);
-    C_jk_acc = Lm * (Cd.topLeftCorner<3, 3>() + Ckey) * Lm.transpose();
-    Cxi_k_acc = Cd.bottomRightCorner<3, 3>();
+    C_jk_acc = Lm * (Cd_acc.topLeftCorner<3, 3>() + Ckey) * Lm.transpose();
+    Cxi_k_acc = Cd_acc.bottomRightCorner<3, 3>();
     se2::compoundXyYaw(M_j, P_jm_, T_jk, C_jk_acc, T_unused, P_m_next);
   }
+  blendStartRate(config_, key_stamp_ != rel_key_stamp_, prev_pair_xi_(2), T_w_prev, pair.T_12, T_w);
   pair.T_12 = se2::inverse(T_w_prev) * T_w;
   rel_key_stamp_ = key_stamp_;
   rel_T_ = T_rel;

@@ -60,6 +60,7 @@
 #include "spinradar/features/matcher.hpp"
 #include "spinradar/estimation/scan_period.hpp"
 #include "spinradar/estimation/direction_scales.hpp"
+#include "spinradar/estimation/keyframe_start_rate.hpp"  // blendStartRate
 #include "spinradar/estimation/mc_ransac.hpp"
 #include "spinradar/estimation/motion_estimate.hpp"
 #include "spinradar/estimation/nearest_point_grid.hpp"
