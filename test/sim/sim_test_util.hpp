@@ -12,6 +12,15 @@ inline Trajectory constantMotion(double vx, double wz, Pose2 start = {}, double 
   return Trajectory::fromProfile({{dur, vx, wz}}, start, 0.0, 200.0);
 }
 
+/// The evaluation matrix's full physics: motion distortion, Doppler (beta 0.049 s), moving cars.
+inline PhysicsConfig fullPhysics() {
+  PhysicsConfig p;
+  p.motion_distortion = true;
+  p.doppler = 0.049;
+  p.moving_objects = true;
+  return p;
+}
+
 inline World oneTarget(double x, double y, double rcs = 25.0) {
   World w;
   w.targets.push_back({x, y, rcs, 0, 0});

@@ -18,6 +18,7 @@
 #include "spinradar/estimation/odometry.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
+#include "sim_test_util.hpp"
 
 using namespace spinradar;
 
@@ -60,14 +61,10 @@ TurnEntry run(const sim::Simulator& s, const sim::Trajectory& traj, int k0, int 
 }  // namespace
 
 TEST(KeyframeGraphTurnEntry, RateCorrectionKeepsThePublishedPoseAtARampingTurnEntry) {
-  sim::PhysicsConfig physics;
-  physics.motion_distortion = true;
-  physics.doppler = 0.049;
-  physics.moving_objects = true;
   sim::SensorConfig narrow;
   narrow.range_psf_sigma_bins = 0.64;
   const sim::Scene sc = sim::builtinScene("city", 2);
-  const sim::Simulator s(sc.world, sc.trajectory, narrow, physics, 1);
+  const sim::Simulator s(sc.world, sc.trajectory, narrow, sim::testing::fullPhysics(), 1);
   const int k0 = 0, k1 = 116;         // t = 0 .. 29 s
   const double t0 = 23.5, t1 = 28.0;  // the turn entry and the scans chained from it
   const TurnEntry off = run(s, sc.trajectory, k0, k1, t0, t1, 0, false);

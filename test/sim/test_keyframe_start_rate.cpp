@@ -18,6 +18,7 @@
 #include "spinradar/estimation/odometry.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
+#include "sim_test_util.hpp"
 
 using namespace spinradar;
 
@@ -49,7 +50,8 @@ std::vector<int> blendedScans(const std::vector<OdometryResult>& r, bool& rotati
     const Eigen::Matrix3d T = pose[r[k].keyframe_stamp_ns] * r[k].T_keyframe_sensor;
     const Eigen::Vector3d d = se2::log(se2::inverse(T) * r[k].T_world_sensor);
     out[k] = d.norm() > 1e-9;
-    const Eigen::Vector2d dp = T.topRightCorner<2, 1>() - r[k].T_world_sensor.topRightCorner<2, 1>();
+    const Eigen::Vector2d dp =
+        T.topRightCorner<2, 1>() - r[k].T_world_sensor.topRightCorner<2, 1>();
     if (out[k] && dp.norm() > 1e-9) rotation_only = false;
   }
   return out;
@@ -58,12 +60,9 @@ std::vector<int> blendedScans(const std::vector<OdometryResult>& r, bool& rotati
 }  // namespace
 
 TEST(KeyframeStartRate, BlendsOnlyAfterTurnSwitchesAndLowersTheirHeadingError) {
-  sim::PhysicsConfig physics;
-  physics.motion_distortion = true;
-  physics.doppler = 0.049;
-  physics.moving_objects = true;
   const sim::Scene sc = sim::builtinScene("tight_turns", 0);
-  const sim::Simulator s(sc.world, sc.trajectory, sim::SensorConfig{}, physics, 1);
+  const sim::Simulator s(sc.world, sc.trajectory, sim::SensorConfig{}, sim::testing::fullPhysics(),
+                         1);
   const int scans = 240;  // 60 s: the scene's turns one after another
   const std::vector<OdometryResult> off = run(s, scans, 0.0);
   const std::vector<OdometryResult> on = run(s, scans, 0.25);
