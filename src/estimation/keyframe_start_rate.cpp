@@ -8,11 +8,16 @@
 
 namespace spinradar {
 
+bool startRateBlends(const EstimatorConfig& cfg, double switch_pair_yaw_rate, double dt) {
+  const double rate = std::abs(switch_pair_yaw_rate);
+  return rate > kStartRateTurnRate && rate * dt <= cfg.keyframe_angle;
+}
+
 void blendStartRate(const EstimatorConfig& cfg, bool after_switch, double switch_pair_yaw_rate,
-                    const Eigen::Matrix3d& T_w_prev, const Eigen::Matrix3d& pair_T_12,
+                    double dt, const Eigen::Matrix3d& T_w_prev, const Eigen::Matrix3d& pair_T_12,
                     Eigen::Matrix3d& T_w) {
   const double w = cfg.start_rate_pair_weight;
-  if (w <= 0.0 || !after_switch || std::abs(switch_pair_yaw_rate) <= kStartRateTurnRate) return;
+  if (w <= 0.0 || !after_switch || !startRateBlends(cfg, switch_pair_yaw_rate, dt)) return;
   // The two yaw increments over the same step (scan start to scan start).
   const Eigen::Matrix3d step = se2::inverse(T_w_prev) * T_w;
   const double d_key = std::atan2(step(1, 0), step(0, 0));

@@ -272,7 +272,6 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   const Eigen::Vector3d& xi_k = xi_key;
   // Yaw-rate change since the last scan beyond what white-noise acceleration explains.
   const double dw_step = std::max(0.0, std::abs(xi_k(2) - prev_xi_(2)) - kAngAccelSigma * dt);
-  const double dw2 = dw_step * dw_step;
   const Eigen::Matrix3d E_j = se2::exp(key_c_ * key_xi_);
   const Eigen::Matrix3d T_rel = E_j * T_jk * se2::exp(-c * xi_k);
   Eigen::Matrix3d C_rel;
@@ -288,7 +287,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     // A yaw-rate step (turn entry, exit) can fall anywhere in this scan: the yaw rate worked
     // back with is off by between 0 and the step (uniform: second moment dw^2 / 3). Without this the turn exits held NEES of 100-800 (1-1.8 deg errors
     // against 0.06-0.15 deg sigmas).
-    Cd(5, 5) += dw2 / 3.0;
+    Cd(5, 5) += dw_step * dw_step / 3.0;
     // Row keypoints: a target moves by a fractional number of rows between the keyframe and
     // this scan and every match rounds it the same way, so the registration's yaw has an
     // error common to all its points, about uniform over a row (variance step^2 / 12), which
@@ -339,7 +338,8 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     Cxi_k_acc = Cd_acc.bottomRightCorner<3, 3>();
     se2::compoundXyYaw(M_j, P_jm_, T_jk, C_jk_acc, T_unused, P_m_next);
   }
-  blendStartRate(config_, key_stamp_ != rel_key_stamp_, prev_pair_xi_(2), T_w_prev, pair.T_12, T_w);
+  blendStartRate(config_, key_stamp_ != rel_key_stamp_, prev_pair_xi_(2), dt, T_w_prev, pair.T_12,
+                 T_w);
   pair.T_12 = se2::inverse(T_w_prev) * T_w;
   rel_key_stamp_ = key_stamp_;
   rel_T_ = T_rel;
@@ -385,7 +385,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     pushPastKeyframe();
     key_rel_cov_ = C_jk_acc;
     key_xi_cov_ = xi_cov_pub;
-    key_xi_cov_(2, 2) += dw2 / 3.0;  // as above: the keyframe map was moved with that yaw rate
+    key_xi_cov_(2, 2) += dw_step * dw_step / 3.0;  // as above: the keyframe map was moved with that yaw rate
     makeKeyframe(cur, xi_key, c, T_w, P);
     key_edges_.swap(new_edges_);
     key_pair_xi_ = pair.velocity;

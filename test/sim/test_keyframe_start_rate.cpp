@@ -2,7 +2,8 @@
 // on the simulator against its truth: the tight_turns scene with full physics (motion
 // distortion, Doppler, moving cars), noise seed 1, the default pipeline otherwise. The option
 // publishes the first scan after a keyframe switch made in a turn (pair yaw rate over 3 deg/s
-// at the switching scan) with its yaw increment blended with the pair estimate's. Checked:
+// at the switching scan, one scan turning no further than keyframe_angle) with its yaw
+// increment blended with the pair estimate's. Checked:
 // at weight 0 every published pose is the keyframe's times the relative pose (as without the
 // option); at 0.25 exactly the scans right after turn switches differ from that, by a
 // rotation about their own position; and their heading is closer to the truth.
@@ -14,7 +15,6 @@
 #include <vector>
 
 #include "spinradar/core/lie.hpp"
-#include "spinradar/estimation/keyframe_start_rate.hpp"
 #include "spinradar/estimation/odometry.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
@@ -25,6 +25,7 @@ using namespace spinradar;
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
+const double kSwitchAngle = EstimatorConfig{}.keyframe_angle;
 
 std::vector<OdometryResult> run(const sim::Simulator& s, int scans, double w) {
   PipelineConfig cfg;
@@ -75,9 +76,11 @@ TEST(KeyframeStartRate, BlendsOnlyAfterTurnSwitchesAndLowersTheirHeadingError) {
   for (size_t k = 3; k + 1 < on.size(); ++k) {  // after the first keyframe (scan 1)
     EXPECT_NE(b_off[k], 1) << "weight 0 changed scan " << k;
     if (b_on[k] < 0) continue;
-    const bool after_turn_switch =
-        on[k].keyframe_stamp_ns == on[k - 1].stamp_ns &&
-        std::abs(on[k - 1].motion.velocity(2)) > kStartRateTurnRate;
+    // A turn: over 3 deg/s; not one where a scan alone turns further than the switch angle.
+    const double rate = std::abs(on[k - 1].motion.velocity(2));
+    const double dt = 1e-9 * static_cast<double>(on[k].stamp_ns - on[k - 1].stamp_ns);
+    const bool after_turn_switch = on[k].keyframe_stamp_ns == on[k - 1].stamp_ns &&
+                                   rate > 3.0 * kDeg && rate * dt <= kSwitchAngle;
     expected += after_turn_switch;
     blended += b_on[k];
     wrong += b_on[k] != static_cast<int>(after_turn_switch);

@@ -23,12 +23,20 @@ namespace spinradar {
 /// turn: the truth turning faster than 3 deg/s is what round 15 called a turn.
 constexpr double kStartRateTurnRate = 3.0 * 3.14159265358979323846 / 180.0;
 
+/// Whether the scan after a keyframe switch is blended: the switching scan's pair yaw rate
+/// (rad/s) over kStartRateTurnRate, and that rate times the scan period dt (s) at most
+/// cfg.keyframe_angle. Above it one scan alone turns further than the switch angle (the
+/// keyframe_angle_fast regime, round 15: out_and_back_v2's U-turn at up to 86 deg/s, the city
+/// turns under 40); there the pair estimate is made under the turn's largest distortion and
+/// blending it made the U-turn's exit 0.3-0.6 deg worse (round 16).
+bool startRateBlends(const EstimatorConfig& cfg, double switch_pair_yaw_rate, double dt);
+
 /// T_w: the published pose of a scan (T_w_prev the previous scan's, pair_T_12 the pair step
-/// between them), blended with weight cfg.start_rate_pair_weight when after_switch (the
-/// previous scan became the keyframe) and |switch_pair_yaw_rate| (the pair's at that scan)
-/// exceeds kStartRateTurnRate. Weight 0: T_w untouched.
+/// between them, dt the scan period), blended with weight cfg.start_rate_pair_weight when
+/// after_switch (the previous scan became the keyframe) and startRateBlends(). Weight 0: T_w
+/// untouched.
 void blendStartRate(const EstimatorConfig& cfg, bool after_switch, double switch_pair_yaw_rate,
-                    const Eigen::Matrix3d& T_w_prev, const Eigen::Matrix3d& pair_T_12,
+                    double dt, const Eigen::Matrix3d& T_w_prev, const Eigen::Matrix3d& pair_T_12,
                     Eigen::Matrix3d& T_w);
 
 }  // namespace spinradar
