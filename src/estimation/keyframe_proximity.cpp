@@ -48,7 +48,7 @@ void KeyframeTracker::offerPairMatches(int64_t prev_stamp_ns, int64_t cur_stamp_
 void KeyframeTracker::beginScan(const FeatureFrame& cur, double nndr) {
   // The pair's matches are this scan's against the keyframe when that keyframe was made from
   // the scan they were matched with, in the last track() (so its descriptors are that scan's).
-  const bool pair_is_key = has_key_ && key_fresh_ && offered_ != nullptr &&
+  const bool pair_is_key = !exhaustive_ && has_key_ && key_fresh_ && offered_ != nullptr &&
                            offered_prev_ns_ == key_stamp_ && offered_cur_ns_ == cur.stamp_ns &&
                            offered_nndr_ == nndr;
   pair_matches_ = pair_is_key ? offered_ : nullptr;
@@ -131,7 +131,7 @@ void KeyframeTracker::associateByProximity(const FeatureFrame& cur, const Eigen:
     const Eigen::Vector2d qh(M[0][0] * px + M[0][1] * py + M[0][2],
                              M[1][0] * px + M[1][1] * py + M[1][2]);
     ProximityAnchor& a = cache.anchors[i];
-    int best_j = boundedNearest(a, qh, gate, key_pts_);
+    int best_j = exhaustive_ ? key_grid_.nearest(qh, gate) : boundedNearest(a, qh, gate, key_pts_);
     if (best_j == kUndecided) {  // search, and anchor the next queries here
       int wide = -1;
       double second2 = 0.0;

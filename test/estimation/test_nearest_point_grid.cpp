@@ -121,3 +121,51 @@ TEST(NearestPointGrid, CellEdgesAndWideMapsInX) {
       ASSERT_EQ(grid.nearest(q, gate), bruteNearest(spread, q, gate)) << "query " << k;
   }
 }
+
+// nearest(q, gate, radius, wide, second2): the gate's answer as nearest(q, gate), and from the
+// same pass the nearest within the radius and the second-nearest's squared distance (radius^2
+// when there is none), all against a scan over every point (ties included).
+TEST(NearestPointGrid, WiderRadiusGivesTheGatesAnswerAndABound) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-160.0, 160.0), near(-2.0, 2.0);
+  NearestPointGrid grid;
+  int bounded = 0, queries = 0;
+  for (int map = 0; map < 4; ++map) {
+    const std::vector<Eigen::Vector2d> pts = scanLikeMap(rng, 3000);
+    grid.build(pts);
+    for (int k = 0; k < 3000; ++k) {
+      const Eigen::Vector2d q = k % 2 ? pts[static_cast<size_t>(k) % pts.size()] +
+                                            Eigen::Vector2d(near(rng), near(rng))
+                                      : Eigen::Vector2d(u(rng), u(rng));
+      for (const double gate : {0.3, 0.6, 1.5})
+        for (const double radius : {gate, 1.0, 2.5}) {
+          if (radius < gate) continue;
+          int wide = -7;
+          double second2 = -7.0;
+          ASSERT_EQ(grid.nearest(q, gate, radius, wide, second2), bruteNearest(pts, q, gate))
+              << "map " << map << " query " << k << " gate " << gate << " radius " << radius;
+          ASSERT_EQ(wide, bruteNearest(pts, q, radius));
+          double want2 = radius * radius;  // the second smallest squared distance under it
+          for (size_t i = 0; i < pts.size(); ++i) {
+            const double dx = pts[i].x() - q.x(), dy = pts[i].y() - q.y();
+            if (static_cast<int>(i) != wide) want2 = std::min(want2, dx * dx + dy * dy);
+          }
+          ASSERT_EQ(second2, want2) << "map " << map << " query " << k << " radius " << radius;
+          bounded += second2 < radius * radius;
+          ++queries;
+        }
+    }
+    // An exact duplicate: the second-nearest is the copy, at the same distance.
+    int wide = -1;
+    double second2 = -1.0;
+    grid.nearest(pts[1], 0.3, 1.0, wide, second2);
+    EXPECT_EQ(second2, 0.0);
+  }
+  EXPECT_GT(bounded, queries / 10);  // second-nearest points were found, not only the radius
+  // Nothing searched (a non-finite query, an empty gate): no bound.
+  int wide = 0;
+  double second2 = 0.0;
+  EXPECT_EQ(grid.nearest({std::numeric_limits<double>::quiet_NaN(), 0.0}, 0.3, 1.0, wide, second2), -1);
+  EXPECT_EQ(wide, -1);
+  EXPECT_LT(second2, 0.0);
+}

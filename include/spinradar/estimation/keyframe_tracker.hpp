@@ -114,6 +114,9 @@ class KeyframeTracker {
   /// keyframe matching's own and it is not repeated (keyframe_proximity.cpp).
   void offerPairMatches(int64_t prev_stamp_ns, int64_t cur_stamp_ns, double nndr,
                         const std::vector<Match>& matches);
+  /// For tests: every proximity query searched in the grid and every offer ignored (the
+  /// shortcuts of keyframe_proximity.cpp off; the results must not change).
+  void setExhaustiveSearch(bool on) { exhaustive_ = on; }
 
   /// Variances over [x, y, yaw] of what a constant-velocity step of dt seconds leaves out:
   /// white-noise acceleration (kStepAccelSigma, kStepAngAccelSigma) over the step. Added to
@@ -307,6 +310,7 @@ class KeyframeTracker {
   /// proximity anchors and the offered matches hold for one map only.
   int key_map_id_ = -1, map_ids_ = 0, fresh_map_id_ = -1;
   bool key_fresh_ = false;  ///< the keyframe was made in the last track()
+  bool exhaustive_ = false;  ///< setExhaustiveSearch()
   KeyframeCachesPtr caches_;
   SolveTermCache& solveTerms();
   /// Fills the match arrays by proximity to the prediction (see kProximityGate).
