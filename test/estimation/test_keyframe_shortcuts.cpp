@@ -8,11 +8,11 @@
 
 #include <cstring>
 #include <functional>
-#include <random>
 
 #include "support/glint_scene.hpp"
 #include "support/noisy_prior.hpp"
 #include "support/synthetic_scene.hpp"
+#include "support/view_dependent_descriptors.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/estimation/keyframe_tracker.hpp"
 #include "spinradar/features/matcher.hpp"
@@ -86,27 +86,16 @@ TEST(KeyframeShortcuts, SamePosesAsTheFullSearchUnderGlint) {
 }
 
 TEST(KeyframeShortcuts, SamePosesAsTheFullSearchInAViewDependentTurn) {
-  constexpr double kDeg = M_PI / 180.0;
   std::vector<Eigen::Vector3d> v;
   for (int k = 0; k < 40; ++k) v.emplace_back(5.0, 0.0, (k >= 10 && k < 22) ? 0.625 : 0.0);
   SceneOptions o = clutteredDopplerScene(21);
   o.beta = 0.0;
   o.velocity_shift = 0.3 * o.period;
   SyntheticScene scene(o, v);
-  // Descriptors lose bits with the heading (as test_keyframe_tracker's turn): keyframes
-  // 15-20 deg back no longer match, and the proximity ICP registers.
-  std::mt19937 rng(21);
-  std::uniform_real_distribution<double> u01(0.0, 1.0);
-  std::vector<double> flip_at(static_cast<size_t>(o.landmarks) * 256);
-  for (double& t : flip_at) t = 45.0 * kDeg * u01(rng);
+  // Descriptors lose bits with the heading: keyframes 15-20 deg back no longer match.
+  const spinradar::testing::ViewDependentDescriptors flips(o.landmarks, 21);
   const Hook view = [&](SyntheticScene& sc, int k, FeatureFrame& f, const std::vector<int>& ids) {
-    const double heading = std::abs(se2::log(sc.pose(sc.scanStart(k)))(2));
-    for (size_t r = 0; r < ids.size(); ++r) {
-      if (ids[r] < 0) continue;
-      for (int b = 0; b < 256; ++b)
-        if (flip_at[static_cast<size_t>(ids[r]) * 256 + b] < heading)
-          f.descriptors.at<uint8_t>(static_cast<int>(r), b / 8) ^= static_cast<uint8_t>(1u << (b % 8));
-    }
+    flips.apply(sc, k, f, ids);
   };
   int past = 0;
   EXPECT_GE(compareRuns(scene, v, 40, view, past), 4);

@@ -1,7 +1,7 @@
 // The proximity anchors (src/estimation/proximity_bound.hpp): an anchor laid by a wide search
 // decides a later query only with the grid's own answer. Random keyframe-like maps, anchors
-// at random points, queries moved by random rigid motions of up to 0.6 m (the ICP moves
-// millimetres; a turn's prediction error up to decimetres), at the tracker's gates; every
+// at random points, queries moved by random rigid motions of 0.1 mm to 16 cm (the ICP moves
+// millimetres between its solves), at the tracker's gates; every
 // decided query is checked against the grid and against a scan over every point.
 #include <gtest/gtest.h>
 
@@ -10,28 +10,11 @@
 #include <vector>
 
 #include "../../src/estimation/proximity_bound.hpp"
+#include "support/brute_nearest.hpp"
 #include "spinradar/estimation/nearest_point_grid.hpp"
 
 using namespace spinradar;
-
-namespace {
-
-int bruteNearest(const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector2d& q, double gate) {
-  double best = gate * gate;
-  int best_j = -1;
-  for (size_t i = 0; i < pts.size(); ++i) {
-    const double dx = pts[i].x() - q.x(), dy = pts[i].y() - q.y(), d2 = dx * dx + dy * dy;
-    if (d2 < best || (best_j >= 0 && d2 == best &&
-                      (pts[i].x() < pts[best_j].x() ||
-                       (pts[i].x() == pts[best_j].x() && static_cast<int>(i) < best_j)))) {
-      best = d2;
-      best_j = static_cast<int>(i);
-    }
-  }
-  return best_j;
-}
-
-}  // namespace
+using spinradar::testing::bruteNearest;
 
 TEST(ProximityBound, HoldsOverRandomMotions) {
   std::mt19937 rng(5);
