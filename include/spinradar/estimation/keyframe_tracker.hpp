@@ -50,7 +50,6 @@
 // A new keyframe is taken when the current one is far (distance, angle), when the
 // registration keeps too few inliers, or when it fails (then the pose is the prior).
 #include <cstdint>
-#include <memory>
 #include <utility>
 #include <vector>
 
@@ -61,6 +60,7 @@
 #include "spinradar/features/matcher.hpp"
 #include "spinradar/estimation/scan_period.hpp"
 #include "spinradar/estimation/direction_scales.hpp"
+#include "spinradar/estimation/keyframe_caches_ptr.hpp"
 #include "spinradar/estimation/mc_ransac.hpp"
 #include "spinradar/estimation/motion_estimate.hpp"
 #include "spinradar/estimation/nearest_point_grid.hpp"
@@ -68,21 +68,6 @@
 #include "spinradar/core/params.hpp"
 
 namespace spinradar {
-
-struct KeyframeCaches;  // src/estimation/keyframe_proximity.cpp
-struct SolveTermCache;  // src/estimation/keyframe_caches.hpp
-/// Owns the tracker's caches (work reused at keyframe switches); a copy starts without them.
-class KeyframeCachesPtr {
- public:
-  KeyframeCachesPtr();
-  ~KeyframeCachesPtr();
-  KeyframeCachesPtr(const KeyframeCachesPtr&);
-  KeyframeCachesPtr& operator=(const KeyframeCachesPtr&);
-  KeyframeCaches* operator->() const { return p_.get(); }
-
- private:
-  std::unique_ptr<KeyframeCaches> p_;
-};
 
 class KeyframeTracker {
  public:
@@ -304,7 +289,7 @@ class KeyframeTracker {
   void beginScan(const FeatureFrame& cur, double nndr);
   const std::vector<Match>* offered_ = nullptr;  ///< offerPairMatches(), for the next track()
   const std::vector<Match>* pair_matches_ = nullptr;  ///< the offer, valid for fresh_map_id_
-  int64_t offered_prev_ns_ = 0, offered_cur_ns_ = 0;
+  int64_t offered_prev_ns_ = 0, offered_cur_ns_ = 0;  ///< and its stamps and ratio
   double offered_nndr_ = 0.0;
   /// Keyframe maps are numbered (makeKeyframe; swapped with PastKeyframe::map_id): the
   /// proximity anchors and the offered matches hold for one map only.
