@@ -38,6 +38,7 @@ void KeyframeTracker::swapKeyframe(PastKeyframe& pk) {
   std::swap(key_desc_, pk.desc);
   std::swap(key_desc_storage_, pk.desc_storage);
   std::swap(key_accel_, pk.accel);
+  std::swap(key_map_id_, pk.map_id);
 }
 
 void KeyframeTracker::pushPastKeyframe() {
@@ -94,14 +95,7 @@ bool KeyframeTracker::registerToPast(const FeatureFrame& cur, PastKeyframe& pk, 
   // would be fused with (docs/sensor_columns/round10a_glint_registration_fusion.md).
   bool ok = false;
   if (!cur.descriptors.empty() && !key_desc_.empty()) {
-    matchDescriptors(key_desc_, cur.descriptors, nndr_, matches_);
-    qx_.clear(); qy_.clear(); px_.clear(); py_.clear(); ux_.clear(); uy_.clear(); tau_.clear();
-    key_tau_m_.clear();
-    for (const Match& m : matches_) {
-      const Keypoint& k = cur.keypoints[m.i2];
-      addMatch(static_cast<size_t>(m.i1), cur, static_cast<size_t>(m.i2),
-               1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c);
-    }
+    pairByDescriptors(cur, c, nndr_);
     ok = solveFrom(cov, cov_pub, cov_acc);
     if (!ok && graph) {  // keyframe_graph: a weak registration too (as track()'s)
       T = T_pred;

@@ -1,7 +1,7 @@
 // The keyframe map of KeyframeTracker: taking a scan as the keyframe (its points
-// Doppler-corrected and moved to its mid-scan reference) and pairing a scan's keypoints with
-// it (descriptor matches are filled in track(); proximity to a prediction here). Split from
-// keyframe_tracker.cpp (the registration and the covariances) to keep files small.
+// Doppler-corrected and moved to its mid-scan reference). Pairing a scan's keypoints with it:
+// keyframe_proximity.cpp. Split from keyframe_tracker.cpp (the registration and the
+// covariances) to keep files small.
 #include <algorithm>
 #include <cmath>
 
@@ -65,6 +65,8 @@ void KeyframeTracker::makeKeyframe(const FeatureFrame& f, const Eigen::Vector3d&
   key_c_ = c;
   key_xi_ = xi;
   key_stamp_ = f.stamp_ns;
+  key_map_id_ = ++map_ids_;  // a new map: anchors of the old one no longer hold
+  key_fresh_ = true;
   T_jprev_.setIdentity();
   C_jprev_.setZero();
   C_jprev_pub_.setZero();
@@ -109,63 +111,6 @@ void KeyframeTracker::averageWithSubmap(const Eigen::Matrix3d& M_w) {
   submap_next_ = (submap_next_ + 1) % slots;
   submap_count_ = std::min(submap_count_ + 1, slots);
   for (size_t i = 0; i < n; ++i) key_pts_[i] = avg_sum_[i] / avg_n_[i];
-}
-
-void KeyframeTracker::cacheDirections(const FeatureFrame& cur) {
-  const size_t n = cur.keypoints.size();
-  if (cur_dirs_.capacity() < n) cur_dirs_.reserve(n + n / 2);
-  cur_dirs_.resize(n);
-  for (size_t i = 0; i < n; ++i)
-    cur_dirs_[i] = {std::cos(cur.keypoints[i].azimuth), -std::sin(cur.keypoints[i].azimuth)};
-}
-
-void KeyframeTracker::addMatch(size_t key_index, const FeatureFrame& cur, size_t i, double tau) {
-  qx_.push_back(key_pts_[key_index].x());
-  qy_.push_back(key_pts_[key_index].y());
-  key_tau_m_.push_back(key_tau_[key_index]);
-  px_.push_back(cur.keypoints[i].x);
-  py_.push_back(cur.keypoints[i].y);
-  ux_.push_back(cur_dirs_[i].x());
-  uy_.push_back(cur_dirs_[i].y());
-  tau_.push_back(tau);
-}
-
-void KeyframeTracker::associateByProximity(const FeatureFrame& cur, const Eigen::Matrix3d& T_pred,
-                                           const Eigen::Vector3d& xi, double c, double gate) {
-  qx_.clear(); qy_.clear(); px_.clear(); py_.clear(); ux_.clear(); uy_.clear(); tau_.clear();
-  key_tau_m_.clear();
-  hold_floor_ = true;  // nearest-point pairs within a gate: their spread is not the returns'
-  const size_t n = cur.keypoints.size();
-  if (qx_.capacity() < n) {  // rare: a scan with more keypoints than the keyframe's headroom
-    for (auto* v : {&qx_, &qy_, &px_, &py_, &ux_, &uy_, &tau_, &key_tau_m_}) v->reserve(n + n / 2);
-    in_.reserve(n + n / 2);
-    dirs_.reserve(n + n / 2);
-  }
-  if (cur_dirs_.size() != n) cacheDirections(cur);  // track() caches them; kept in step here too
-  const double beta = config_.beta;
-  // Keypoints of one stamp (a row; with azimuth peaks each has its own) share the motion
-  // M = T_pred exp(tau xi): its top two rows, written out (Eigen's 3x3 temporaries stalled on
-  // store forwarding; the same sums in the same order, so the same bits).
-  double M[2][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}};
-  double row_tau = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    const Keypoint& k = cur.keypoints[i];
-    const double tau = 1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c;
-    if (i == 0 || tau != row_tau) {
-      const Eigen::Matrix3d E = se2::exp(tau * xi);
-      for (int r = 0; r < 2; ++r)
-        for (int col = 0; col < 3; ++col)
-          M[r][col] = T_pred(r, 0) * E(0, col) + T_pred(r, 1) * E(1, col) + T_pred(r, 2) * E(2, col);
-      row_tau = tau;
-    }
-    const double ux = cur_dirs_[i].x(), uy = cur_dirs_[i].y();
-    const double d = beta * (ux * xi(0) + uy * xi(1));
-    const double px = k.x + d * ux, py = k.y + d * uy;
-    const Eigen::Vector2d qh(M[0][0] * px + M[0][1] * py + M[0][2],
-                             M[1][0] * px + M[1][1] * py + M[1][2]);
-    const int best_j = key_grid_.nearest(qh, gate);
-    if (best_j >= 0) addMatch(static_cast<size_t>(best_j), cur, i, tau);
-  }
 }
 
 }  // namespace spinradar

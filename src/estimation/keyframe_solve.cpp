@@ -9,6 +9,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
+#include "keyframe_caches.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/core/normal_equations.hpp"
 #include "spinradar/estimation/mc_ransac.hpp"
@@ -26,6 +27,8 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
   const double beta = config_.beta, sr = config_.range_sigma, sa = config_.azimuth_sigma;
   const int n = static_cast<int>(qx_.size());
   in_.assign(n, 1);
+  SolveTermCache& terms = solveTerms();
+  terms.reset(static_cast<size_t>(n));
   const Eigen::Matrix3d Wp = (C_prior + 1e-10 * Eigen::Matrix3d::Identity()).inverse();
   const Eigen::Matrix3d Wv = Cxi_prior.inverse();
   const Eigen::Vector3d prior_pose = se2::toXyYaw(T_prior);
@@ -80,8 +83,11 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
     D << beta * ux * ux, beta * ux * uy, 0.0, beta * uy * ux, beta * uy * uy, 0.0;
     t.J.rightCols<3>() = -t.CT * (tau_[m] * se2::odot2(t.g) + t.CE * D);
     const Eigen::Matrix2d CC = t.CT * t.CE;
-    t.S = cartesianCovariance(t.q, sr, sa, fl) +
-          CC * cartesianCovariance(t.pc, sr, sa, fl) * CC.transpose();
+    if (!(terms.floor[m] == fl)) {  // the keyframe point's term: once per solve and floor
+      terms.cov_q[m] = cartesianCovariance(t.q, sr, sa, fl);
+      terms.floor[m] = fl;
+    }
+    t.S = terms.cov_q[m] + CC * cartesianCovariance(t.pc, sr, sa, fl) * CC.transpose();
     t.Si = t.S.inverse();
     t.JtW = t.J.transpose() * t.Si;
   };

@@ -26,7 +26,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   // The pair velocity's yaw rate changed by over kRampYawAccel in the last scan (a ramp).
   const bool pair_ramp = std::abs(pair.velocity(2) - prev_pair_xi_(2)) > kRampYawAccel * dt;
   row_step_ = rowQuantization(cur);
-  cacheDirections(cur);
+  beginScan(cur, nndr);
   if (!has_key_) {
     se2::compoundXyYaw(T_w_prev, P_prev, pair.T_12, pair.T_12_cov, T_w, P);
     rel_key_stamp_ = cur.stamp_ns;
@@ -69,14 +69,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     C_jk = C_jprev_;
     C_pub = C_jprev_pub_;
   } else {
-    matchDescriptors(key_desc_, cur.descriptors, nndr, matches_);
-    qx_.clear(); qy_.clear(); px_.clear(); py_.clear(); ux_.clear(); uy_.clear(); tau_.clear();
-    key_tau_m_.clear();
-    for (const Match& m : matches_) {
-      const Keypoint& k = cur.keypoints[m.i2];
-      addMatch(static_cast<size_t>(m.i1), cur, static_cast<size_t>(m.i2),
-               1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c);
-    }
+    pairByDescriptors(cur, c, nndr);
     // The pair velocity is centred about half a scan before scan k's own; within a scan the
     // yaw rate is only weakly observable (it trades against the yaw), so this prior has to
     // stay tight: inflated for a tenth of a scan (kPriorLag), not half. Extrapolating it by
@@ -385,7 +378,7 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     pushPastKeyframe();
     key_rel_cov_ = C_jk_acc;
     key_xi_cov_ = xi_cov_pub;
-    key_xi_cov_(2, 2) += dw_step * dw_step / 3.0;  // as above: the keyframe map was moved with that yaw rate
+    key_xi_cov_(2, 2) += dw_step * dw_step / 3.0;  // as above: its map was moved with that rate
     makeKeyframe(cur, xi_key, c, T_w, P);
     key_edges_.swap(new_edges_);
     key_pair_xi_ = pair.velocity;

@@ -128,4 +128,48 @@ int NearestPointGrid::nearest(const Eigen::Vector2d& q, double gate) const {
   return best_j;
 }
 
+// The same visit as nearest(q, radius), with the gate's answer kept apart: a point is a
+// candidate for it only where nearest(q, gate) would visit it (its bands and x range), so the
+// answer is that search's even at the edges of its region.
+int NearestPointGrid::nearest(const Eigen::Vector2d& q, double gate, double radius, int& wide,
+                              double& second2) const {
+  wide = -1;
+  second2 = radius * radius;
+  if (bands_ == 0 || !(gate > 0.0) || !(radius >= gate) || !std::isfinite(q.x()) ||
+      !std::isfinite(q.y())) {
+    second2 = -1.0;  // no search: no bound
+    return nearest(q, gate);
+  }
+  double best = gate * gate, best_x = 0.0, wbest = radius * radius, wbest_x = 0.0;
+  int best_j = -1;
+  const double gx_lo = q.x() - gate, gx_hi = q.x() + gate;
+  const int g_lo = bandOf(q.y() - gate), g_hi = bandOf(q.y() + gate);
+  const int b_hi = bandOf(q.y() + radius);
+  for (int b = bandOf(q.y() - radius); b <= b_hi; ++b) {
+    const bool gate_band = b >= g_lo && b <= g_hi;
+    const Entry* it = firstAtOrAfter(b, q.x() - radius);
+    const Entry* const last = entries_.data() + band_start_[b + 1];
+    for (; it != last && it->x <= q.x() + radius; ++it) {
+      const double dx = it->x - q.x(), dy = it->y - q.y(), d2 = dx * dx + dy * dy;
+      if (gate_band && it->x >= gx_lo && it->x <= gx_hi &&
+          (d2 < best || (best_j >= 0 && d2 == best &&
+                         (it->x < best_x || (it->x == best_x && it->index < best_j))))) {
+        best = d2;
+        best_x = it->x;
+        best_j = it->index;
+      }
+      if (d2 < wbest || (wide >= 0 && d2 == wbest &&
+                         (it->x < wbest_x || (it->x == wbest_x && it->index < wide)))) {
+        if (wide >= 0) second2 = wbest;  // the one it displaces is now second
+        wbest = d2;
+        wbest_x = it->x;
+        wide = it->index;
+      } else if (d2 < second2) {
+        second2 = d2;
+      }
+    }
+  }
+  return best_j;
+}
+
 }  // namespace spinradar

@@ -236,6 +236,8 @@ struct Odometry::Impl {
           dopplerCorrect(cur.frame.keypoints, m.velocity, config.estimator.beta, corr2);
         }
       }
+      keyframe.offerPairMatches(prev.frame.stamp_ns, cur.frame.stamp_ns, config.features.nndr,
+                                matches);
       if (ok && estimator == Estimator::kKeyframe) {
         Eigen::Matrix3d T_new, P_new;
         keyframe.track(cur.frame, T_world, pose_cov, config.features.nndr, m, T_new, P_new);

@@ -11,6 +11,7 @@
 #include <Eigen/Cholesky>
 
 #include "support/synthetic_scene.hpp"
+#include "support/view_dependent_descriptors.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/estimation/odometry.hpp"
 
@@ -167,18 +168,9 @@ TEST(KeyframeTracker, TurnWithViewDependentDescriptors) {
     SceneOptions o = options(seed);
     o.velocity_shift = 0.3 * o.period;
     SyntheticScene scene(o, v);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> u01(0.0, 1.0);
-    std::vector<double> flip_at(static_cast<size_t>(o.landmarks) * 256);
-    for (double& t : flip_at) t = 45.0 * kDeg * u01(rng);
+    const spinradar::testing::ViewDependentDescriptors flips(o.landmarks, seed);
     const Hook view = [&](SyntheticScene& sc, int k, FeatureFrame& f, const std::vector<int>& ids) {
-      const double heading = std::abs(se2::log(sc.pose(sc.scanStart(k)))(2));
-      for (size_t r = 0; r < ids.size(); ++r) {
-        if (ids[r] < 0) continue;
-        for (int b = 0; b < 256; ++b)
-          if (flip_at[static_cast<size_t>(ids[r]) * 256 + b] < heading)
-            f.descriptors.at<uint8_t>(static_cast<int>(r), b / 8) ^= static_cast<uint8_t>(1u << (b % 8));
-      }
+      flips.apply(sc, k, f, ids);
     };
     const Drive kf = run("keyframe", scene, 34, view);
     EXPECT_LT(kf.final_yaw_err, 0.2 * kDeg) << "seed " << seed;

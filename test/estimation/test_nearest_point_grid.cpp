@@ -7,29 +7,13 @@
 #include <limits>
 #include <random>
 
+#include "support/brute_nearest.hpp"
 #include "spinradar/estimation/nearest_point_grid.hpp"
 
 using namespace spinradar;
+using spinradar::testing::bruteNearest;
 
 namespace {
-
-// The reference: the x-sorted strip's answer, i.e. the smallest squared distance under
-// gate^2, ties to the smaller (x, index).
-int bruteNearest(const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector2d& q, double gate) {
-  double best = gate * gate;
-  int best_j = -1;
-  for (size_t i = 0; i < pts.size(); ++i) {
-    const double dx = pts[i].x() - q.x(), dy = pts[i].y() - q.y(), d2 = dx * dx + dy * dy;
-    const bool tie_wins = best_j >= 0 && d2 == best &&
-                          (pts[i].x() < pts[best_j].x() ||
-                           (pts[i].x() == pts[best_j].x() && static_cast<int>(i) < best_j));
-    if (d2 < best || tie_wins) {
-      best = d2;
-      best_j = static_cast<int>(i);
-    }
-  }
-  return best_j;
-}
 
 std::vector<Eigen::Vector2d> scanLikeMap(std::mt19937& rng, int n) {
   std::uniform_real_distribution<double> u(-150.0, 150.0), wall(-1.0, 1.0);
@@ -44,21 +28,24 @@ std::vector<Eigen::Vector2d> scanLikeMap(std::mt19937& rng, int n) {
   return pts;
 }
 
+// Half the queries close to a map point (the tracker's case), half anywhere.
+Eigen::Vector2d query(std::mt19937& rng, const std::vector<Eigen::Vector2d>& pts, int k) {
+  std::uniform_real_distribution<double> u(-160.0, 160.0), near(-2.0, 2.0);
+  return k % 2 ? pts[static_cast<size_t>(k) % pts.size()] + Eigen::Vector2d(near(rng), near(rng))
+               : Eigen::Vector2d(u(rng), u(rng));
+}
+
 }  // namespace
 
 TEST(NearestPointGrid, SameAnswerAsAScanOverEveryPoint) {
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-160.0, 160.0), near(-2.0, 2.0);
   NearestPointGrid grid;
   int found = 0, queries = 0;
   for (int map = 0; map < 5; ++map) {
     const std::vector<Eigen::Vector2d> pts = scanLikeMap(rng, 3000);
     grid.build(pts);
     for (int k = 0; k < 4000; ++k) {
-      // Half the queries close to a map point (the tracker's case), half anywhere.
-      const Eigen::Vector2d q = k % 2 ? pts[static_cast<size_t>(k) % pts.size()] +
-                                            Eigen::Vector2d(near(rng), near(rng))
-                                      : Eigen::Vector2d(u(rng), u(rng));
+      const Eigen::Vector2d q = query(rng, pts, k);
       for (const double gate : {0.3, 0.5, 0.6, 1.5, 2.0}) {
         const int want = bruteNearest(pts, q, gate);
         ASSERT_EQ(grid.nearest(q, gate), want) << "map " << map << " query " << k << " gate " << gate;
@@ -120,4 +107,49 @@ TEST(NearestPointGrid, CellEdgesAndWideMapsInX) {
     for (const double gate : {0.3, 1.5})
       ASSERT_EQ(grid.nearest(q, gate), bruteNearest(spread, q, gate)) << "query " << k;
   }
+}
+
+// nearest(q, gate, radius, wide, second2): the gate's answer as nearest(q, gate), and from the
+// same pass the nearest within the radius and the second-nearest's squared distance (radius^2
+// when there is none), all against a scan over every point (ties included).
+TEST(NearestPointGrid, WiderRadiusGivesTheGatesAnswerAndABound) {
+  std::mt19937 rng(11);
+  NearestPointGrid grid;
+  int bounded = 0, queries = 0;
+  for (int map = 0; map < 4; ++map) {
+    const std::vector<Eigen::Vector2d> pts = scanLikeMap(rng, 3000);
+    grid.build(pts);
+    for (int k = 0; k < 3000; ++k) {
+      const Eigen::Vector2d q = query(rng, pts, k);
+      for (const double gate : {0.3, 0.6, 1.5})
+        for (const double radius : {gate, 1.0, 2.5}) {
+          if (radius < gate) continue;
+          int wide = -7;
+          double second2 = -7.0;
+          ASSERT_EQ(grid.nearest(q, gate, radius, wide, second2), bruteNearest(pts, q, gate))
+              << "map " << map << " query " << k << " gate " << gate << " radius " << radius;
+          ASSERT_EQ(wide, bruteNearest(pts, q, radius));
+          double want2 = radius * radius;  // the second smallest squared distance under it
+          for (size_t i = 0; i < pts.size(); ++i) {
+            const double dx = pts[i].x() - q.x(), dy = pts[i].y() - q.y();
+            if (static_cast<int>(i) != wide) want2 = std::min(want2, dx * dx + dy * dy);
+          }
+          ASSERT_EQ(second2, want2) << "map " << map << " query " << k << " radius " << radius;
+          bounded += second2 < radius * radius;
+          ++queries;
+        }
+    }
+    // An exact duplicate: the second-nearest is the copy, at the same distance.
+    int wide = -1;
+    double second2 = -1.0;
+    grid.nearest(pts[1], 0.3, 1.0, wide, second2);
+    EXPECT_EQ(second2, 0.0);
+  }
+  EXPECT_GT(bounded, queries / 10);  // second-nearest points were found, not only the radius
+  // Nothing searched (a non-finite query, an empty gate): no bound.
+  int wide = 0;
+  double second2 = 0.0;
+  EXPECT_EQ(grid.nearest({std::numeric_limits<double>::quiet_NaN(), 0.0}, 0.3, 1.0, wide, second2), -1);
+  EXPECT_EQ(wide, -1);
+  EXPECT_LT(second2, 0.0);
 }

@@ -60,6 +60,7 @@
 #include "spinradar/features/matcher.hpp"
 #include "spinradar/estimation/scan_period.hpp"
 #include "spinradar/estimation/direction_scales.hpp"
+#include "spinradar/estimation/keyframe_caches_ptr.hpp"
 #include "spinradar/estimation/keyframe_start_rate.hpp"  // blendStartRate
 #include "spinradar/estimation/mc_ransac.hpp"
 #include "spinradar/estimation/motion_estimate.hpp"
@@ -93,6 +94,15 @@ class KeyframeTracker {
   void track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_prev,
              const Eigen::Matrix3d& P_prev, double nndr, MotionEstimate& pair,
              Eigen::Matrix3d& T_w, Eigen::Matrix3d& P);
+  /// Before track(): the pair's descriptor matches of the previous scan (prev_stamp_ns) and
+  /// cur (cur_stamp_ns) at ratio nndr, read by that track() only (kept by reference until it
+  /// returns). Where the keyframe is that previous scan (right after a switch) they are the
+  /// keyframe matching's own and it is not repeated (keyframe_proximity.cpp).
+  void offerPairMatches(int64_t prev_stamp_ns, int64_t cur_stamp_ns, double nndr,
+                        const std::vector<Match>& matches);
+  /// For tests: every proximity query searched in the grid and every offer ignored (the
+  /// shortcuts of keyframe_proximity.cpp off; the results must not change).
+  void setExhaustiveSearch(bool on) { exhaustive_ = on; }
 
   /// Variances over [x, y, yaw] of what a constant-velocity step of dt seconds leaves out:
   /// white-noise acceleration (kStepAccelSigma, kStepAngAccelSigma) over the step. Added to
@@ -274,6 +284,21 @@ class KeyframeTracker {
   /// The next solve keeps last_floor_ (its matches are nearest-point pairs, see solve()).
   bool hold_floor_ = false;
   std::vector<double> near_t_;  ///< |tangential residual| of the near matches (solve)
+  /// Fills matches_ and the match arrays by descriptors against the keyframe in use.
+  void pairByDescriptors(const FeatureFrame& cur, double c, double nndr);
+  /// track()'s start: the offered pair matches (if they are the keyframe's), the directions.
+  void beginScan(const FeatureFrame& cur, double nndr);
+  const std::vector<Match>* offered_ = nullptr;  ///< offerPairMatches(), for the next track()
+  const std::vector<Match>* pair_matches_ = nullptr;  ///< the offer, valid for fresh_map_id_
+  int64_t offered_prev_ns_ = 0, offered_cur_ns_ = 0;  ///< and its stamps and ratio
+  double offered_nndr_ = 0.0;
+  /// Keyframe maps are numbered (makeKeyframe; swapped with PastKeyframe::map_id): the
+  /// proximity anchors and the offered matches hold for one map only.
+  int key_map_id_ = -1, map_ids_ = 0, fresh_map_id_ = -1;
+  bool key_fresh_ = false;  ///< the keyframe was made in the last track()
+  bool exhaustive_ = false;  ///< setExhaustiveSearch()
+  KeyframeCachesPtr caches_;
+  SolveTermCache& solveTerms();
   /// Fills the match arrays by proximity to the prediction (see kProximityGate).
   void associateByProximity(const FeatureFrame& cur, const Eigen::Matrix3d& T_pred,
                             const Eigen::Vector3d& xi, double c, double gate);
@@ -323,6 +348,7 @@ class KeyframeTracker {
     double c = 0.0;                                    ///< key_c_
     int64_t stamp = 0;                                 ///< key_stamp_
     std::vector<GraphEdge> edges;  ///< keyframe_graph: its edges to earlier keyframes
+    int map_id = -1;               ///< key_map_id_
   };
   std::vector<GraphEdge> key_edges_, new_edges_;  ///< the current keyframe's, the new one's
   /// solveGraph's buffers, kept so that a keyframe switch allocates nothing after warm-up.

@@ -24,6 +24,14 @@ class NearestPointGrid {
   bool empty() const { return entries_.empty(); }
   /// The index of the nearest point with squared distance under gate^2 from q; -1 if none.
   int nearest(const Eigen::Vector2d& q, double gate) const;
+  /// nearest(q, gate), to the bit, and from the same pass over the points within radius
+  /// (>= gate): the nearest point there (`wide`, -1 if none) and the squared distance of the
+  /// second-nearest (`second2`, radius^2 if none; -1 when nothing was searched: an empty
+  /// gate or a non-finite q). Every point but `wide` lies at least
+  /// sqrt(second2) from q (up to rounding), which bounds later queries near q
+  /// (proximity_bound.hpp). Keeps the second-nearest distance for that bound.
+  int nearest(const Eigen::Vector2d& q, double gate, double radius, int& wide,
+              double& second2) const;
 
   static constexpr double kBand = 1.0;  ///< m, band height (gates are 0.3-1.5 m)
   static constexpr double kCell = 1.0;  ///< m, x cell width of the directory (at least)
