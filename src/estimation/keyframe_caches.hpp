@@ -6,6 +6,10 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "spinradar/estimation/nearest_point_grid.hpp"
+#include "spinradar/features/matcher.hpp"
 
 #include "proximity_bound.hpp"
 
@@ -40,6 +44,17 @@ struct SolveTermCache {
     floor.assign(n, std::numeric_limits<double>::quiet_NaN());
     cov_q.resize(n);
   }
+};
+
+/// The screen of a past keyframe's descriptor registration (keyframe_screen.cpp): the scan's
+/// keypoints moved by the prediction, a grid over them, the keyframe rows split by whether a
+/// moved keypoint lies within the first gate, their descriptors and matches.
+struct DescriptorScreen {
+  std::vector<Eigen::Vector2d> moved;
+  NearestPointGrid grid;
+  std::vector<int> near_rows, far_rows;
+  cv::Mat desc_storage;
+  std::vector<Match> near_matches, far_matches;
 };
 
 }  // namespace spinradar

@@ -26,6 +26,7 @@ constexpr double kAnchorRadius = 1.0;
 struct KeyframeCaches {
   ProximityCache proximity;
   SolveTermCache solve;
+  DescriptorScreen screen;
 };
 
 KeyframeCachesPtr::KeyframeCachesPtr() : p_(new KeyframeCaches) {}
@@ -37,6 +38,7 @@ KeyframeCachesPtr& KeyframeCachesPtr::operator=(const KeyframeCachesPtr&) {
 }
 
 SolveTermCache& KeyframeTracker::solveTerms() { return caches_->solve; }
+DescriptorScreen& KeyframeTracker::descriptorScreen() { return caches_->screen; }
 
 void KeyframeTracker::offerPairMatches(int64_t prev_stamp_ns, int64_t cur_stamp_ns, double nndr,
                                        const std::vector<Match>& matches) {
@@ -84,8 +86,9 @@ void KeyframeTracker::pairByDescriptors(const FeatureFrame& cur, double c, doubl
   // pair's matches of that scan and this one at the same ratio: they are this matching's.
   if (pair_matches_ != nullptr && key_map_id_ == fresh_map_id_)
     matches_.assign(pair_matches_->begin(), pair_matches_->end());
-  else
+  else if (!screened_)  // screenPastDescriptors() left this matching in matches_
     matchDescriptors(key_desc_, cur.descriptors, nndr, matches_);
+  screened_ = false;
   qx_.clear(); qy_.clear(); px_.clear(); py_.clear(); ux_.clear(); uy_.clear(); tau_.clear();
   key_tau_m_.clear();
   for (const Match& m : matches_) {

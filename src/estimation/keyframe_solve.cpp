@@ -141,8 +141,10 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
       weights(m, floor_m, t);
       A.noalias() += t.JtW * t.J;
       b.noalias() -= t.JtW * t.e;
-      const double r = t.q.norm();
-      if (r < near_r) {  // near_r is 0 unless measure_floor
+      // near_r is 0 unless measure_floor (no r is under it: its square root, a fifth of the
+      // iteration's time in the proximity ICP, is skipped).
+      const double r = near_r > 0.0 ? t.q.norm() : 0.0;
+      if (r < near_r) {
         const Eigen::Vector2d u = radial(t);
         if (u.allFinite()) {
           near_t_.push_back(std::abs(u.x() * t.e.y() - u.y() * t.e.x()));
