@@ -36,13 +36,24 @@ struct ProximityCache {
 struct SolveTermCache {
   std::vector<Eigen::Matrix2d> cov_q;
   std::vector<double> floor;  ///< the floor cov_q[m] holds; NaN: not yet computed
+  /// An inlier's terms in the latest Gauss-Newton iteration, which the pass after the last
+  /// iteration (residual scales, acceleration sensitivities) reads instead of recomputing
+  /// them at the same point (the same values: issue 19, sixteenth speed round).
+  struct Last {
+    Eigen::Matrix<double, 6, 2> JtW;
+    Eigen::Matrix2d S;
+    Eigen::Vector2d e, g, ccpc;  ///< ccpc: the scan point rotated into the keyframe (radial)
+  };
+  std::vector<Last> last;
   void reset(size_t n) {
     if (floor.capacity() < n) {
       floor.reserve(n + n / 2);
       cov_q.reserve(n + n / 2);
+      last.reserve(n + n / 2);
     }
     floor.assign(n, std::numeric_limits<double>::quiet_NaN());
     cov_q.resize(n);
+    last.resize(n);
   }
 };
 

@@ -5,7 +5,8 @@
 // registrations to past keyframes at every switch) and a turn with view-dependent
 // descriptors (the proximity ICP against the keyframe and the past ones). The fast tracker's
 // screen of the past keyframes' descriptor matchings (skipped where they cannot pass the first
-// gate, else made in two parts and merged) is off in the full one.
+// gate, else made in two parts and merged) and the solve's terms kept from its last iteration
+// for the covariance pass are off in the full one.
 #include <gtest/gtest.h>
 
 #include <cstring>

@@ -100,8 +100,10 @@ class KeyframeTracker {
   /// keyframe matching's own and it is not repeated (keyframe_proximity.cpp).
   void offerPairMatches(int64_t prev_stamp_ns, int64_t cur_stamp_ns, double nndr,
                         const std::vector<Match>& matches);
-  /// For tests: every proximity query searched in the grid and every offer ignored (the
-  /// shortcuts of keyframe_proximity.cpp off; the results must not change).
+  /// For tests: every proximity query searched in the grid, every offer ignored, every past
+  /// keyframe matched in full and the solve's kept terms computed again (the shortcuts of
+  /// keyframe_proximity.cpp, keyframe_screen.cpp and keyframe_solve.cpp off; the results must
+  /// not change).
   void setExhaustiveSearch(bool on) { exhaustive_ = on; }
 
   /// Variances over [x, y, yaw] of what a constant-velocity step of dt seconds leaves out:
