@@ -94,7 +94,14 @@ bool KeyframeTracker::registerToPast(const FeatureFrame& cur, PastKeyframe& pk, 
   // (turns) and registrations with kMinWeakInliers were measured worse than the chain they
   // would be fused with (docs/sensor_columns/round10a_glint_registration_fusion.md).
   bool ok = false;
-  if (!cur.descriptors.empty() && !key_desc_.empty()) {
+  // The descriptor solves' fewest inliers (strict, and weak with the graph); screened first
+  // (keyframe_screen.cpp): where even that many cannot pass the first gate both solves fail
+  // there, and only hold_floor_ is left as they would leave it.
+  const int need = graph ? std::min(min_inliers_, kMinWeakInliers) : min_inliers_;
+  if (!cur.descriptors.empty() && !key_desc_.empty() &&
+      pastDescriptorsFail(cur, T_pred, xi_prior, c, nndr_, need)) {
+    hold_floor_ = false;
+  } else if (!cur.descriptors.empty() && !key_desc_.empty()) {
     pairByDescriptors(cur, c, nndr_);
     ok = solveFrom(cov, cov_pub, cov_acc);
     if (!ok && graph) {  // keyframe_graph: a weak registration too (as track()'s)

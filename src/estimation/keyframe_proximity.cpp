@@ -10,6 +10,7 @@
 //    queries without the grid (proximity_bound.hpp).
 #include <cmath>
 
+#include "approx_se2_exp.hpp"
 #include "keyframe_caches.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/estimation/keyframe_tracker.hpp"
@@ -25,6 +26,7 @@ constexpr double kAnchorRadius = 1.0;
 struct KeyframeCaches {
   ProximityCache proximity;
   SolveTermCache solve;
+  DescriptorScreen screen;
 };
 
 KeyframeCachesPtr::KeyframeCachesPtr() : p_(new KeyframeCaches) {}
@@ -36,6 +38,7 @@ KeyframeCachesPtr& KeyframeCachesPtr::operator=(const KeyframeCachesPtr&) {
 }
 
 SolveTermCache& KeyframeTracker::solveTerms() { return caches_->solve; }
+DescriptorScreen& KeyframeTracker::descriptorScreen() { return caches_->screen; }
 
 void KeyframeTracker::offerPairMatches(int64_t prev_stamp_ns, int64_t cur_stamp_ns, double nndr,
                                        const std::vector<Match>& matches) {
@@ -83,8 +86,9 @@ void KeyframeTracker::pairByDescriptors(const FeatureFrame& cur, double c, doubl
   // pair's matches of that scan and this one at the same ratio: they are this matching's.
   if (pair_matches_ != nullptr && key_map_id_ == fresh_map_id_)
     matches_.assign(pair_matches_->begin(), pair_matches_->end());
-  else
+  else if (!screened_)  // screenPastDescriptors() left this matching in matches_
     matchDescriptors(key_desc_, cur.descriptors, nndr, matches_);
+  screened_ = false;
   qx_.clear(); qy_.clear(); px_.clear(); py_.clear(); ux_.clear(); uy_.clear(); tau_.clear();
   key_tau_m_.clear();
   for (const Match& m : matches_) {
@@ -115,29 +119,58 @@ void KeyframeTracker::associateByProximity(const FeatureFrame& cur, const Eigen:
   // store forwarding; the same sums in the same order, so the same bits).
   double M[2][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}};
   double row_tau = 0.0;
+  bool have_M = false;
+  // A query an anchor may decide is first moved with the series exponential (approx_se2_exp.hpp):
+  // its error, 1e-15 per entry of E, moves the query by under 1e-14 (1 + |p| + |v| + |t|) m
+  // with rounding; 1e-13 of that is the slack. Undecided, it is moved again with se2::exp.
+  const double t_abs = std::abs(T_pred(0, 2)) + std::abs(T_pred(1, 2));
+  double Ms[2][3], Es[2][3];
+  double series_tau = 0.0;
+  bool have_Ms = false;  ///< Ms holds the series motion of series_tau
   for (size_t i = 0; i < n; ++i) {
     const Keypoint& k = cur.keypoints[i];
     const double tau = 1e-9 * static_cast<double>(k.stamp_ns - cur.stamp_ns) - c;
-    if (i == 0 || tau != row_tau) {
-      const Eigen::Matrix3d E = se2::exp(tau * xi);
-      for (int r = 0; r < 2; ++r)
-        for (int col = 0; col < 3; ++col)
-          M[r][col] = T_pred(r, 0) * E(0, col) + T_pred(r, 1) * E(1, col) + T_pred(r, 2) * E(2, col);
-      row_tau = tau;
-    }
     const double ux = cur_dirs_[i].x(), uy = cur_dirs_[i].y();
     const double d = beta * (ux * xi(0) + uy * xi(1));
     const double px = k.x + d * ux, py = k.y + d * uy;
-    const Eigen::Vector2d qh(M[0][0] * px + M[0][1] * py + M[0][2],
-                             M[1][0] * px + M[1][1] * py + M[1][2]);
     ProximityAnchor& a = cache.anchors[i];
-    int best_j = exhaustive_ ? key_grid_.nearest(qh, gate) : boundedNearest(a, qh, gate, key_pts_);
-    if (best_j == kUndecided) {  // search, and anchor the next queries here
-      int wide = -1;
-      double second2 = 0.0;
-      best_j = key_grid_.nearest(qh, gate, radius, wide, second2);
-      const bool finite = std::isfinite(qh.x()) && std::isfinite(qh.y());
-      a = ProximityAnchor{qh.x(), qh.y(), finite && second2 >= 0.0 ? std::sqrt(second2) : -1.0, wide};
+    int best_j = kUndecided;
+    if (!exhaustive_ && a.sep >= 0.0 && (!have_M || tau != row_tau)) {
+      const Eigen::Vector3d v = tau * xi;
+      if ((have_Ms && tau == series_tau) || seriesExp2x3(v, Es)) {
+        if (!have_Ms || tau != series_tau) {
+          for (int r = 0; r < 2; ++r)
+            for (int col = 0; col < 3; ++col)
+              Ms[r][col] = T_pred(r, 0) * Es[0][col] + T_pred(r, 1) * Es[1][col] + (col == 2 ? T_pred(r, 2) : 0.0);
+          series_tau = tau;
+          have_Ms = true;
+        }
+        const Eigen::Vector2d qs(Ms[0][0] * px + Ms[0][1] * py + Ms[0][2],
+                                 Ms[1][0] * px + Ms[1][1] * py + Ms[1][2]);
+        const double slack =
+            1e-13 * (1.0 + std::abs(px) + std::abs(py) + std::abs(v(0)) + std::abs(v(1)) + t_abs);
+        best_j = boundedNearest(a, qs, gate, key_pts_, slack);
+      }
+    }
+    if (best_j == kUndecided) {
+      if (!have_M || tau != row_tau) {
+        const Eigen::Matrix3d E = se2::exp(tau * xi);
+        for (int r = 0; r < 2; ++r)
+          for (int col = 0; col < 3; ++col)
+            M[r][col] = T_pred(r, 0) * E(0, col) + T_pred(r, 1) * E(1, col) + T_pred(r, 2) * E(2, col);
+        row_tau = tau;
+        have_M = true;
+      }
+      const Eigen::Vector2d qh(M[0][0] * px + M[0][1] * py + M[0][2],
+                               M[1][0] * px + M[1][1] * py + M[1][2]);
+      best_j = exhaustive_ ? key_grid_.nearest(qh, gate) : boundedNearest(a, qh, gate, key_pts_);
+      if (best_j == kUndecided) {  // search, and anchor the next queries here
+        int wide = -1;
+        double second2 = 0.0;
+        best_j = key_grid_.nearest(qh, gate, radius, wide, second2);
+        const bool finite = std::isfinite(qh.x()) && std::isfinite(qh.y());
+        a = ProximityAnchor{qh.x(), qh.y(), finite && second2 >= 0.0 ? std::sqrt(second2) : -1.0, wide};
+      }
     }
     if (best_j >= 0) addMatch(static_cast<size_t>(best_j), cur, i, tau);
   }

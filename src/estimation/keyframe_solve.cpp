@@ -91,10 +91,14 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
     t.Si = t.S.inverse();
     t.JtW = t.J.transpose() * t.Si;
   };
-  // Radial direction for the residual scales (cov_acc): between the two points' own.
-  auto radial = [](const Terms& t) {
+  // The scan point rotated into the keyframe, and the radial direction for the residual
+  // scales (cov_acc): between the two points' own.
+  auto rotated = [](const Terms& t) {
     const Eigen::Matrix2d CC = t.CT * t.CE;
-    return Eigen::Vector2d((t.q.normalized() + (CC * t.pc).normalized()).normalized());
+    return Eigen::Vector2d(CC * t.pc);
+  };
+  auto radial = [](const Eigen::Vector2d& q, const Eigen::Vector2d& ccpc) {
+    return Eigen::Vector2d((q.normalized() + ccpc.normalized()).normalized());
   };
   Terms t;
   Eigen::Matrix3d T_last = T;  ///< the last iteration's linearization point (see below)
@@ -139,11 +143,19 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
       if (regate) in_[m] = t.e.squaredNorm() <= gate2;
       if (!in_[m]) continue;
       weights(m, floor_m, t);
+      SolveTermCache::Last& l = terms.last[static_cast<size_t>(m)];
+      l.JtW = t.JtW;
+      l.S = t.S;
+      l.e = t.e;
+      l.g = t.g;
+      l.ccpc = rotated(t);
       A.noalias() += t.JtW * t.J;
       b.noalias() -= t.JtW * t.e;
-      const double r = t.q.norm();
-      if (r < near_r) {  // near_r is 0 unless measure_floor
-        const Eigen::Vector2d u = radial(t);
+      // near_r is 0 unless measure_floor (no r is under it: its square root, a fifth of the
+      // iteration's time in the proximity ICP, is skipped).
+      const double r = near_r > 0.0 ? t.q.norm() : 0.0;
+      if (r < near_r) {
+        const Eigen::Vector2d u = radial(t.q, l.ccpc);
         if (u.allFinite()) {
           near_t_.push_back(std::abs(u.x() * t.e.y() - u.y() * t.e.x()));
           near_var += std::pow(std::max(r, 1.0) * sa, 2);
@@ -179,23 +191,34 @@ bool KeyframeTracker::solve(const Eigen::Matrix3d& T_prior, const Eigen::Matrix3
   }
   // The residual scales (dirs_) and the acceleration sensitivities (B) of cov_acc are those of
   // the last iteration only: one pass over its inliers at its linearization point, instead of
-  // in every iteration (the same values: issue 19, session 17).
+  // in every iteration (the same values: issue 19, session 17), from the terms that iteration
+  // kept (terms.last: every inlier's is the last iteration's, which set in_). The exhaustive
+  // tracker (setExhaustiveSearch) computes them again, for the tests to compare.
   B.setZero();
   dirs_.clear();
   have_E = false;
+  const Eigen::Matrix2d CT_last = T_last.topLeftCorner<2, 2>();
+  SolveTermCache::Last again;
   for (int m = 0; m < n; ++m) {
     if (!in_[m]) continue;
-    residual(m, T_last, xi_last, t);
-    weights(m, floor_last, t);
-    const Eigen::Vector2d u = radial(t);
-    dirs_.add(t.e, t.S, u.allFinite() ? u : Eigen::Vector2d::UnitX(), t.JtW);
+    const SolveTermCache::Last* kept = &terms.last[static_cast<size_t>(m)];
+    if (exhaustive_) {
+      residual(m, T_last, xi_last, t);
+      weights(m, floor_last, t);
+      again = SolveTermCache::Last{t.JtW, t.S, t.e, t.g, rotated(t)};
+      kept = &again;
+    }
+    const SolveTermCache::Last& l = *kept;
+    const Eigen::Vector2d q(qx_[m], qy_[m]);
+    const Eigen::Vector2d u = radial(q, l.ccpc);
+    dirs_.add(l.e, l.S, u.allFinite() ? u : Eigen::Vector2d::UnitX(), l.JtW);
     // Acceleration within this scan moves the point by exp(tau^2/2 a) and within the
     // keyframe's scan its map point by exp(tau_j^2/2 a_j): residual sensitivities.
     const double tj = key_tau_m_[m];
     Eigen::Matrix<double, 2, 6> Ja;
-    Ja.leftCols<3>() = -0.5 * tau_[m] * tau_[m] * t.CT * se2::odot2(t.g);
-    Ja.rightCols<3>() = 0.5 * tj * tj * se2::odot2(t.q);
-    B.noalias() += t.JtW * Ja;
+    Ja.leftCols<3>() = -0.5 * tau_[m] * tau_[m] * CT_last * se2::odot2(l.g);
+    Ja.rightCols<3>() = 0.5 * tj * tj * se2::odot2(q);
+    B.noalias() += l.JtW * Ja;
   }
   last_floor_ = floor_m;
   last_inliers_ = cnt;

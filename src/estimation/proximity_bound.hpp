@@ -29,20 +29,23 @@ constexpr double kProximityBoundMargin = 1e-9;
 /// boundedNearest(): the anchor does not decide, search the grid.
 constexpr int kUndecided = -2;
 
-/// NearestPointGrid::nearest(q, gate) on the points pts the grid was built from, when the
-/// anchor proves it; kUndecided otherwise.
+/// NearestPointGrid::nearest(q_true, gate) on the points pts the grid was built from, when the
+/// anchor proves it; kUndecided otherwise. q is q_true or within `slack` (m) of it (a query
+/// computed with approx_se2_exp.hpp): every margin widens by twice the slack, since each
+/// distance from q is then within slack of the true one.
 inline int boundedNearest(const ProximityAnchor& a, const Eigen::Vector2d& q, double gate,
-                          const std::vector<Eigen::Vector2d>& pts) {
+                          const std::vector<Eigen::Vector2d>& pts, double slack = 0.0) {
   if (!(a.sep >= 0.0)) return kUndecided;
+  const double margin = kProximityBoundMargin + 2.0 * slack;
   const double mx = q.x() - a.ax, my = q.y() - a.ay;
   // Every point but a.wide is at least this far from q (NaN for a non-finite q: undecided).
-  const double lower = a.sep - std::sqrt(mx * mx + my * my) - kProximityBoundMargin;
-  const bool none_else = lower > gate + kProximityBoundMargin;  // no other point in the gate
+  const double lower = a.sep - std::sqrt(mx * mx + my * my) - margin;
+  const bool none_else = lower > gate + margin;  // no other point in the gate
   if (a.wide < 0) return none_else ? -1 : kUndecided;
   const Eigen::Vector2d& p = pts[static_cast<size_t>(a.wide)];
   const double dx = p.x() - q.x(), dy = p.y() - q.y(), d = std::sqrt(dx * dx + dy * dy);
-  if (d + kProximityBoundMargin < gate && d + kProximityBoundMargin < lower) return a.wide;
-  if (d > gate + kProximityBoundMargin && none_else) return -1;
+  if (d + margin < gate && d + margin < lower) return a.wide;
+  if (d > gate + margin && none_else) return -1;
   return kUndecided;
 }
 

@@ -23,6 +23,7 @@
 #endif
 
 #include "for_each_above.hpp"
+#include "row_stats.hpp"
 
 namespace spinradar {
 
@@ -277,22 +278,12 @@ void Detector::detectCen2018(const PolarScan& scan, std::vector<Keypoint>& out) 
     cos_[a] = std::cos(scan.azimuth[a]);
     sin_[a] = std::sin(scan.azimuth[a]);
     const uint8_t* row = scan.row(a);
-    uint32_t sum = 0;
-    for (int j = 0; j < n; ++j) sum += row[j];
+    const uint32_t sum = detail::rowSum(row, n);
     const double mean = double(sum) / n;
     // Noise from the samples below the mean: sum (x - mean)^2 = s2 - 2 mean s1 + cnt mean^2.
     const int below = static_cast<int>(std::ceil(mean)) - 1;  // x < mean <=> x <= below
     uint32_t cnt = 0, s1 = 0, s2 = 0;
-    if (below >= 0) {
-      const uint32_t bu = static_cast<uint32_t>(below);
-      for (int j = 0; j < n; ++j) {
-        const uint32_t x = row[j];
-        const uint32_t m = x <= bu ? 1u : 0u;
-        cnt += m;
-        s1 += m * x;
-        s2 += m * x * x;
-      }
-    }
+    if (below >= 0) detail::belowSums(row, n, static_cast<uint32_t>(below), cnt, s1, s2);
     float sigma = kNoiseFallback;
     if (cnt > 0) {
       const double ss = double(s2) - 2.0 * mean * s1 + cnt * mean * mean;

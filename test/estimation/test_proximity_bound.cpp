@@ -74,3 +74,46 @@ TEST(ProximityBound, NoAnchorAndNonFiniteQueriesAreUndecided) {
   // Halfway between the two points: the anchor cannot tell them apart.
   EXPECT_EQ(boundedNearest(a, {0.5, 0.0}, 0.6, pts), kUndecided);
 }
+
+// A query known only to within a slack (keyframe_proximity.cpp computes it with the series
+// exponential first): decided, it is the grid's answer for the true query. A slack far above
+// the tracker's (1e-13 m scale) so that its margins are what the test exercises; queries
+// placed on the gate and half-way between points too.
+TEST(ProximityBound, SlackQueriesGetTheTrueQuerysAnswer) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-60.0, 60.0), unit(-1.0, 1.0);
+  NearestPointGrid grid;
+  std::vector<Eigen::Vector2d> pts;
+  for (int i = 0; i < 2000; ++i) pts.emplace_back(u(rng), i % 2 ? u(rng) : 4.0 * (i % 9) + 0.1 * unit(rng));
+  grid.build(pts);
+  int decided = 0, queries = 0, slack_only_undecided = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const Eigen::Vector2d a0 = pts[static_cast<size_t>(k) % pts.size()] +
+                               Eigen::Vector2d(0.7 * unit(rng), 0.7 * unit(rng));
+    int wide = -1;
+    double second2 = 0.0;
+    grid.nearest(a0, 0.6, 1.0, wide, second2);
+    const ProximityAnchor anchor{a0.x(), a0.y(), std::sqrt(second2), wide};
+    const double gate = k % 2 ? 0.3 : 0.6;
+    Eigen::Vector2d q = a0 + Eigen::Vector2d(0.05 * unit(rng), 0.05 * unit(rng));
+    if (k % 5 == 0 && wide >= 0) {  // on the gate around the anchor's point
+      const Eigen::Vector2d dir = (q - pts[static_cast<size_t>(wide)]).normalized();
+      q = pts[static_cast<size_t>(wide)] + gate * dir;
+    }
+    const double slack = k % 3 == 0 ? 1e-3 : 1e-6;
+    // The computed query: anywhere within the slack of the true one.
+    const double ang = M_PI * unit(rng), len = slack * (0.5 + 0.5 * unit(rng));
+    const Eigen::Vector2d qs = q + len * Eigen::Vector2d(std::cos(ang), std::sin(ang));
+    const int got = boundedNearest(anchor, qs, gate, pts, slack);
+    ++queries;
+    if (got == kUndecided) {
+      slack_only_undecided += boundedNearest(anchor, q, gate, pts) != kUndecided;
+      continue;
+    }
+    ASSERT_EQ(got, grid.nearest(q, gate)) << "query " << k << " slack " << slack;
+    ASSERT_EQ(got, bruteNearest(pts, q, gate));
+    ++decided;
+  }
+  EXPECT_GT(decided, queries / 2);
+  EXPECT_GT(slack_only_undecided, 0);  // the wider margins do leave some to the search
+}

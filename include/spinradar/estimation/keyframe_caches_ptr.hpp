@@ -7,6 +7,7 @@ namespace spinradar {
 
 struct KeyframeCaches;  // src/estimation/keyframe_proximity.cpp
 struct SolveTermCache;  // src/estimation/keyframe_caches.hpp
+struct DescriptorScreen;  // src/estimation/keyframe_caches.hpp
 /// Owns the tracker's caches (work reused at keyframe switches); a copy starts without them.
 class KeyframeCachesPtr {
  public:

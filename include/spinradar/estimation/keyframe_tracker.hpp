@@ -100,8 +100,10 @@ class KeyframeTracker {
   /// keyframe matching's own and it is not repeated (keyframe_proximity.cpp).
   void offerPairMatches(int64_t prev_stamp_ns, int64_t cur_stamp_ns, double nndr,
                         const std::vector<Match>& matches);
-  /// For tests: every proximity query searched in the grid and every offer ignored (the
-  /// shortcuts of keyframe_proximity.cpp off; the results must not change).
+  /// For tests: every proximity query searched in the grid, every offer ignored, every past
+  /// keyframe matched in full and the solve's kept terms computed again (the shortcuts of
+  /// keyframe_proximity.cpp, keyframe_screen.cpp and keyframe_solve.cpp off; the results must
+  /// not change).
   void setExhaustiveSearch(bool on) { exhaustive_ = on; }
 
   /// Variances over [x, y, yaw] of what a constant-velocity step of dt seconds leaves out:
@@ -136,6 +138,9 @@ class KeyframeTracker {
   /// or failed.
   int fusionsAccepted() const { return fusions_accepted_; }
   int fusionsRejected() const { return fusions_rejected_; }
+  /// Past-keyframe descriptor matchings the screen skipped / made in two parts (keyframe_screen.cpp).
+  int screenSkips() const { return screen_skips_; }
+  int screenSplits() const { return screen_splits_; }
   /// keyframe_graph: extra edges dropped by the leave-one-out screen (also in fusionsRejected).
   int graphEdgesDropped() const { return graph_edges_dropped_; }
 
@@ -297,6 +302,12 @@ class KeyframeTracker {
   int key_map_id_ = -1, map_ids_ = 0, fresh_map_id_ = -1;
   bool key_fresh_ = false;  ///< the keyframe was made in the last track()
   bool exhaustive_ = false;  ///< setExhaustiveSearch()
+  bool screened_ = false;  ///< matches_ holds the next pairByDescriptors' matching
+  /// registerToPast's descriptor registration, decided before all of its matching where it
+  /// cannot pass the first gate (keyframe_screen.cpp).
+  bool pastDescriptorsFail(const FeatureFrame& cur, const Eigen::Matrix3d& T_pred,
+                           const Eigen::Vector3d& xi, double c, double nndr, int need);
+  DescriptorScreen& descriptorScreen();
   KeyframeCachesPtr caches_;
   SolveTermCache& solveTerms();
   /// Fills the match arrays by proximity to the prediction (see kProximityGate).
@@ -382,6 +393,7 @@ class KeyframeTracker {
   /// before it (the registration that made it, cov_acc with its model errors).
   Eigen::Matrix3d key_rel_cov_ = Eigen::Matrix3d::Zero();
   int fusions_accepted_ = 0, fusions_rejected_ = 0, graph_edges_dropped_ = 0;
+  int screen_skips_ = 0, screen_splits_ = 0;
   double nndr_ = 0.8;  ///< track()'s ratio test, for the extra registrations
   /// The current scan's velocity prior and its covariances (track()), for the extra ones.
   Eigen::Vector3d fuse_xi_prior_ = Eigen::Vector3d::Zero();
