@@ -121,7 +121,7 @@ bool KeyframeTracker::registerToPast(const FeatureFrame& cur, PastKeyframe& pk, 
     xi = xi_prior;
     ok = solveFrom(cov, cov_pub, cov_acc);
     for (const double g : {kProximityRegate, kReassociateGate}) {
-      for (int r = 0; ok && r < kProximityIterations; ++r) {
+      for (int r = 0; ok && r < config_.proximity_rounds; ++r) {
         const Eigen::Matrix3d T_was = T;
         if (!pairAndSolveAgain(g)) break;
         const Eigen::Vector3d d = se2::log(se2::inverse(T_was) * T);
