@@ -142,13 +142,8 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
       // 0.18 %, but city_noise14 0.13 -> 0.18 % (one turn's keyframes fell differently): an
       // option, off by default (docs/sensor_columns/round09_weak_switches.md). With the last
       // resort settled too RADIATE consistency went 0.191 -> 0.199 deg.
-      // At most proximity_rounds rounds per gate (issue 19, seventeenth round): under the
-      // Oxford model's clutter a fifth of the loops never settle (pairs flip between near
-      // returns) and ran to 30 rounds, most of a switch's cost; 5 rounds left the drift as it
-      // was (geometric mean 1.001 over 22 columns) at 2-3 ms less per scan
-      // (docs/sensor_columns/round17_proximity_rounds.md).
       for (const double g : {kProximityRegate, settle ? config_.proximity_settle_gate : 0.0}) {
-        for (int r = 0; ok && g > 0.0 && r < config_.proximity_rounds; ++r) {
+        for (int r = 0; ok && g > 0.0 && r < kProximityIterations; ++r) {
           const Eigen::Matrix3d T_was = T;
           if (!pairAndSolveAgain(g)) break;
           const Eigen::Vector3d d = se2::log(se2::inverse(T_was) * T);

@@ -1,10 +1,10 @@
-// EstimatorConfig::proximity_rounds (issue 19, docs/sensor_columns/round17_proximity_rounds.md)
-// on the simulator against its truth: the tight_turns scene with full physics, noise seed 1,
-// the default pipeline otherwise. The proximity ICP (descriptors failed against a keyframe
-// turned away from the scan, and the graph's registrations to past keyframes) pairs by
-// proximity and solves again until the pose settles, at most proximity_rounds times per gate.
-// Checked: the rounds matter (one round leaves the turns' heading clearly worse), and the
-// default's few rounds keep the heading of the former 30 rounds.
+// EstimatorConfig::graph_proximity_rounds (issue 19,
+// docs/sensor_columns/round17_proximity_rounds.md) on the simulator against its truth: the
+// tight_turns scene with full physics, noise seed 1, the default pipeline otherwise. A new
+// keyframe is registered against the past keyframes of the graph, by descriptors or else by a
+// proximity ICP (pair by proximity, solve, again, until the pose settles), at most
+// graph_proximity_rounds rounds per gate. Checked: the default's few rounds change poses here
+// (the cap binds), and keep the heading of the former 30 rounds.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -20,25 +20,28 @@
 
 using namespace spinradar;
 
-TEST(ProximityRounds, FewRoundsKeepTheTurnsHeadingAndOneRoundDoesNot) {
+TEST(ProximityRounds, FewRoundsKeepTheTurnsHeading) {
   const sim::Scene sc = sim::builtinScene("tight_turns", 0);
   const sim::Simulator s(sc.world, sc.trajectory, sim::SensorConfig{}, sim::testing::fullPhysics(),
                          1);
   const int scans = 240;  // 60 s: the scene's turns one after another
-  const int default_rounds = EstimatorConfig{}.proximity_rounds;
-  const std::vector<int> rounds = {1, default_rounds, 30};
+  const int default_rounds = EstimatorConfig{}.graph_proximity_rounds;
+  const std::vector<int> rounds = {default_rounds, 30};
+  ASSERT_LT(default_rounds, 30);
   std::vector<std::unique_ptr<Odometry>> odo;
   for (const int r : rounds) {
     PipelineConfig cfg;
-    cfg.estimator.proximity_rounds = r;
+    cfg.estimator.graph_proximity_rounds = r;
     odo.push_back(std::make_unique<Odometry>(cfg));
   }
   // Heading error against the truth, both relative to the first scan: rms over the scans.
   std::vector<double> sq(rounds.size(), 0.0);
+  int differ = 0;  // scans whose pose differs between the two
   double truth0 = 0.0;
   std::vector<double> est0(rounds.size(), 0.0);
   for (int k = 0; k < scans; ++k) {
     const PolarScan scan = s.renderScan(k);
+    Eigen::Matrix3d first;
     for (size_t i = 0; i < rounds.size(); ++i) {
       const OdometryResult r = odo[i]->process(scan);
       ASSERT_TRUE(r.T_world_sensor.allFinite());
@@ -50,16 +53,20 @@ TEST(ProximityRounds, FewRoundsKeepTheTurnsHeadingAndOneRoundDoesNot) {
       }
       const double e = se2::wrapAngle((yaw - est0[i]) - (truth - truth0));
       sq[i] += e * e;
+      if (i == 0) {
+        first = r.T_world_sensor;
+      } else {
+        differ += (r.T_world_sensor - first).norm() > 1e-12;
+      }
     }
   }
   std::vector<double> rms;
   for (const double v : sq) rms.push_back(std::sqrt(v / scans) * 180.0 / M_PI);
   std::cout << "[ info ] tight_turns seed 1, " << scans << " scans, heading error rms deg: "
-            << "1 round " << rms[0] << ", " << default_rounds << " rounds (default) " << rms[1]
-            << ", 30 rounds " << rms[2] << "\n";
-  // Measured: 1 round 1.147 deg, 5 rounds 0.197, 30 rounds 0.194.
-  // The default keeps the former 30 rounds' heading (within 10 % or 0.01 deg).
-  EXPECT_LE(rms[1], 1.1 * rms[2] + 0.01);
-  // One round (a single re-association per gate) is clearly worse: the loop is not idle here.
-  EXPECT_GT(rms[0], 1.3 * rms[1]);
+            << default_rounds << " rounds (default) " << rms[0] << ", 30 rounds " << rms[1]
+            << "; " << differ << " scans differ\n";
+  // Measured: 5 rounds 0.196 deg, 30 rounds 0.194 (1 round 0.195: on this drive the graph's
+  // registrations need few rounds; the Oxford model's clutter is where the rounds went).
+  EXPECT_GT(differ, 0) << "the cap never bound: the parameter is not in effect";
+  EXPECT_LE(rms[0], 1.1 * rms[1] + 0.01);
 }
