@@ -120,8 +120,13 @@ bool KeyframeTracker::registerToPast(const FeatureFrame& cur, PastKeyframe& pk, 
     T = T_pred;
     xi = xi_prior;
     ok = solveFrom(cov, cov_pub, cov_acc);
+    // At most graph_proximity_rounds rounds per gate (seventeenth round): under the Oxford
+    // model's clutter most of these loops never settle (the pairs flip between neighbouring
+    // returns) and ran to 30 rounds, most of a keyframe switch's cost; 5 left the drift as it
+    // was (docs/sensor_columns/round17_proximity_rounds.md). The current keyframe's fallback
+    // keeps its 30: there a wrong prior walks out slowly (test_keyframe_row_smears).
     for (const double g : {kProximityRegate, kReassociateGate}) {
-      for (int r = 0; ok && r < kProximityIterations; ++r) {
+      for (int r = 0; ok && r < config_.graph_proximity_rounds; ++r) {
         const Eigen::Matrix3d T_was = T;
         if (!pairAndSolveAgain(g)) break;
         const Eigen::Vector3d d = se2::log(se2::inverse(T_was) * T);

@@ -155,7 +155,8 @@ class KeyframeTracker {
   /// nearest keyframe point within this distance of the predicted position instead.
   static constexpr double kProximityGate = 1.5;
   /// After a proximity registration: pair again under the solved pose within this gate (m)
-  /// and solve, at most this many times, until the pose settles (keyframe_tracker.cpp).
+  /// and solve, at most this many times, until the pose settles (keyframe_tracker.cpp; the
+  /// registrations to past keyframes: EstimatorConfig::graph_proximity_rounds).
   static constexpr double kProximityRegate = 0.6;
   static constexpr int kProximityIterations = 30;
   /// m, nearest-point re-association after a descriptor registration (keyframe_tracker.cpp)
