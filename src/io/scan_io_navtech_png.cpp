@@ -44,18 +44,6 @@ bool looksLikeChirpColumn(const cv::Mat& img) {
   return mixed == 0 && flips >= (img.rows - 1) * 9 / 10;
 }
 
-/// PolarScan::resize without zeroing the power values first: decodeRows copies every row
-/// over them (a 1.5 MB fill per Oxford scan saved).
-void sizeKeepingPower(int rows, int bins, PolarScan& scan) {
-  scan.azimuths = rows;
-  scan.bins = bins;
-  scan.power.resize(static_cast<size_t>(rows) * bins);
-  scan.azimuth.assign(rows, 0.0);
-  scan.stamp_ns.assign(rows, 0);
-  scan.encoder.assign(rows, 0);
-  scan.valid.assign(rows, 1);
-}
-
 /// Fills `scan` from the image, reusing its buffers (no allocation once it held a scan of this size).
 void decodeRows(const cv::Mat& img, const std::string& name, double resolution, double offset,
                 Column10 col10, PolarScan& scan) {
@@ -72,7 +60,7 @@ void decodeRows(const cv::Mat& img, const std::string& name, double resolution, 
       << " metadata columns + at least 1 bin expected";
     throw std::runtime_error(s.str());
   }
-  sizeKeepingPower(img.rows, img.cols - kNavtechMetaColumns, scan);
+  scan.resizeForOverwrite(img.rows, img.cols - kNavtechMetaColumns);  // every row copied below
   scan.range_resolution = resolution;
   scan.range_offset = offset;
   scan.encoder_size = 5600;

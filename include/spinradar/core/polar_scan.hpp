@@ -1,5 +1,6 @@
 #pragma once
 // One rotation of a spinning FMCW radar in polar form, as the sensor reports it.
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -23,9 +24,15 @@ struct PolarScan {
   std::vector<uint8_t> chirp_up;    ///< optional per-row chirp direction (Boreas-RT); empty = unknown
 
   void resize(int n_azimuths, int n_bins) {
+    resizeForOverwrite(n_azimuths, n_bins);
+    std::fill(power.begin(), power.end(), uint8_t{0});
+  }
+  /// resize() without zeroing the power values, for readers that write every row over them
+  /// (a 1.5 MB fill per Oxford scan saved); the per-azimuth fields are reset as by resize().
+  void resizeForOverwrite(int n_azimuths, int n_bins) {
     azimuths = n_azimuths;
     bins = n_bins;
-    power.assign(static_cast<size_t>(n_azimuths) * n_bins, 0);
+    power.resize(static_cast<size_t>(n_azimuths) * n_bins);
     azimuth.assign(n_azimuths, 0.0);
     stamp_ns.assign(n_azimuths, 0);
     encoder.assign(n_azimuths, 0);
