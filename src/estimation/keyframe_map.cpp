@@ -9,6 +9,7 @@
 #include "spinradar/estimation/doppler.hpp"
 #include "spinradar/estimation/keyframe_tracker.hpp"
 #include "spinradar/estimation/undistort.hpp"
+#include "map_agreement.hpp"
 
 namespace spinradar {
 
@@ -94,7 +95,11 @@ void KeyframeTracker::averageWithSubmap(const Eigen::Matrix3d& M_w) {
   avg_n_.assign(n, 1);
   for (size_t s = 0; s < submap_count_; ++s) {
     const SubmapFrame& o = submap_[s];
-    const Eigen::Matrix3d T_on = se2::inverse(o.M_w) * M_w;  // the new frame in o's
+    // Averaged under the chained poses (which ties the new map to the earlier ones), but not
+    // where the two maps disagree: a chained pose error (a turn entry's keyframe 1-2 deg off)
+    // would be averaged into the new map, half of it, and handed on.
+    const Eigen::Matrix3d T_on = se2::inverse(o.M_w) * M_w;
+    if (!submapAgrees(o, T_on)) continue;
     const Eigen::Matrix2d R = T_on.topLeftCorner<2, 2>();
     const Eigen::Vector2d t = T_on.topRightCorner<2, 1>();
     for (size_t i = 0; i < n; ++i) {
@@ -111,6 +116,17 @@ void KeyframeTracker::averageWithSubmap(const Eigen::Matrix3d& M_w) {
   submap_next_ = (submap_next_ + 1) % slots;
   submap_count_ = std::min(submap_count_ + 1, slots);
   for (size_t i = 0; i < n; ++i) key_pts_[i] = avg_sum_[i] / avg_n_[i];
+}
+
+// o agrees when the fit of its points onto the new map's (map_agreement.hpp) moves it by at
+// most kSubmapAgreeYaw and kSubmapAgreeShift, or when there are fewer than kSubmapMinPairs
+// pairs to tell (then averaged as the pairs fall).
+bool KeyframeTracker::submapAgrees(const SubmapFrame& o, const Eigen::Matrix3d& T_on) const {
+  Eigen::Vector3d d;
+  if (mapMisalignment(key_pts_, o.pts, o.grid, T_on, kSubmapGate, kSubmapMinPairs, d) <
+      kSubmapMinPairs)
+    return true;
+  return std::abs(d(2)) <= kSubmapAgreeYaw && d.head<2>().norm() <= kSubmapAgreeShift;
 }
 
 }  // namespace spinradar

@@ -260,6 +260,9 @@ class KeyframeTracker : public KeyframeTuning {
   /// nearest point within kSubmapGate in each earlier keyframe of the ring, then puts the raw
   /// points into the ring. Nothing with submap_keyframes 1.
   void averageWithSubmap(const Eigen::Matrix3d& M_w);
+  /// Whether o's points, placed with T_on (the new keyframe's frame in o's), agree with the new
+  /// keyframe's (a rigid fit moves them by little); o is averaged only then (keyframe_map.cpp).
+  bool submapAgrees(const SubmapFrame& o, const Eigen::Matrix3d& T_on) const;
   /// EstimatorConfig::keyframe_graph (keyframe_graph.cpp): a measured mid-scan pose Z of a
   /// keyframe relative to the earlier keyframe at stamp `to`, and its [x, y, yaw] covariance.
   struct GraphEdge {

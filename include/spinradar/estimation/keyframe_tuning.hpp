@@ -78,6 +78,14 @@ struct KeyframeTuning {
   /// nearest point within this gate of each earlier keyframe of the submap (keyframe_map.cpp):
   /// 2.5 sigma of the difference of two returns under the simulator's 0.14 m glint.
   static constexpr double kSubmapGate = 0.5;
+  /// A submap keyframe is averaged into the new one unless a rigid fit of its points onto the
+  /// new keyframe's (from at least kSubmapMinPairs pairs) moves it further than these (rad, m):
+  /// then the chained pose between them is off. Consecutive keyframes' maps agree within
+  /// 0.01-0.05 deg on straights and disagree by 0.15-0.45 deg at turn entries, where averaging
+  /// handed half of that on (city_narrow layout 2: 1.3 deg in one switch; round 18).
+  static constexpr int kSubmapMinPairs = 20;
+  static constexpr double kSubmapAgreeYaw = 0.2 * 3.14159265358979323846 / 180.0;
+  static constexpr double kSubmapAgreeShift = 0.15;
   /// EstimatorConfig::keyframe_fusion (keyframe_fusion.cpp): the extra registration against
   /// an earlier keyframe is solved with the chained pose as a prior of this many times its
   /// covariance (a weak pull: it only holds directions the registration leaves open; its
