@@ -83,3 +83,20 @@ TEST(SimElevated, WorldJson) {
     EXPECT_NE(std::string(e.what()).find("elevated"), std::string::npos) << e.what();
   }
 }
+
+// "city_elevated" is "city_facades" target for target and wall for wall, plus appended targets
+// that are all elevated; city_facades itself has none.
+TEST(SimElevated, CityElevatedExtendsCityFacades) {
+  for (uint64_t variant : {0, 1}) {
+    const Scene f = builtinScene("city_facades", variant), e = builtinScene("city_elevated", variant);
+    ASSERT_EQ(f.world.walls.size(), e.world.walls.size());
+    ASSERT_GT(e.world.targets.size(), f.world.targets.size() + 1000);
+    for (size_t i = 0; i < f.world.targets.size(); ++i) {
+      const Target &a = f.world.targets[i], &b = e.world.targets[i];
+      ASSERT_TRUE(a.x == b.x && a.y == b.y && a.rcs == b.rcs && a.vx == b.vx && !a.elevated && !b.elevated) << i;
+    }
+    for (size_t i = f.world.targets.size(); i < e.world.targets.size(); ++i)
+      ASSERT_TRUE(e.world.targets[i].elevated) << i;
+    EXPECT_EQ(e.trajectory.samples().size(), f.trajectory.samples().size());
+  }
+}
