@@ -214,8 +214,8 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
     for (int it = 0; it < 2; ++it)
       a = azOf(bearingCw(x, y, w.px[a], w.py[a], w.cyaw[a], w.syaw[a]));
     // Skip scatterers hidden behind a wall from the crossing pose (with margin: the pose
-    // moves a little across the beam pattern).
-    if (sc.mirror < 0) {
+    // moves a little across the beam pattern). Elevated ones are seen over the walls.
+    if (sc.mirror < 0 && !sc.elevated) {
       double psi = bearingCw(x, y, w.px[a], w.py[a], w.cyaw[a], w.syaw[a]);
       double rr = std::hypot(x - w.px[a], y - w.py[a]);
       int j = std::min(J - 1, int(psi / kTwoPi * J));
@@ -324,7 +324,7 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
         // A ghost shows through its mirror wall only, and only if that hit is not occluded.
         double th = raySegment(px, py, dx / r, dy / r, world.walls[sc.mirror]);
         if (th < 0 || (w.depth_wall[j] != sc.mirror && th > w.depth[j] + tol)) continue;
-      } else if (w.depth_wall[j] != sc.wall && r > w.depth[j] + tol) {
+      } else if (!sc.elevated && w.depth_wall[j] != sc.wall && r > w.depth[j] + tol) {
         continue;
       }
       double p = double(sc.rcs_lin) * model.rangeFactor(r) * g;

@@ -68,6 +68,12 @@ World World::fromJson(const nlohmann::json& j) {
       t.rcs = number(o, at, "rcs", true, 0, -100, 100);
       t.vx = number(o, at, "vx", false, 0, -200, 200);
       t.vy = number(o, at, "vy", false, 0, -200, 200);
+      if (auto e = o.find("elevated"); e != o.end()) {
+        auto path = at;
+        path.push_back({"elevated", -1});
+        if (!e->is_boolean()) throw JsonPathError(path, "must be true or false");
+        t.elevated = e->get<bool>();
+      }
       w.targets.push_back(t);
     }
   }
@@ -99,6 +105,7 @@ nlohmann::json World::toJson() const {
       o["vx"] = t.vx;
       o["vy"] = t.vy;
     }
+    if (t.elevated) o["elevated"] = true;  // written only when set: older worlds keep their bytes
     j["targets"].push_back(o);
   }
   j["walls"] = nlohmann::json::array();

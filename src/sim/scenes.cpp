@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "spinradar/sim/city_elevated.hpp"
 #include "spinradar/sim/city_facades.hpp"
 #include "spinradar/sim/city_layout.hpp"
 #include "render_model.hpp"
@@ -371,7 +372,7 @@ Scene tightTurns(uint64_t variant, double t0) {
 }  // namespace
 
 std::vector<std::string> builtinSceneNames() {
-  return {"city", "city_facades", "city_open", "out_and_back", "tight_turns"};
+  return {"city", "city_elevated", "city_facades", "city_open", "out_and_back", "tight_turns"};
 }
 
 Scene builtinScene(const std::string& name, uint64_t variant, double t0) {
@@ -383,6 +384,15 @@ Scene builtinScene(const std::string& name, uint64_t variant, double t0) {
                       "furniture as point scatterers";
     const detail::CityLayout l;
     detail::addFacadeDetail(sc.world, variant, l.grid, l.pitch_m);
+    return sc;
+  }
+  if (name == "city_elevated") {  // city_facades + what is seen over its walls (city_elevated.hpp)
+    Scene sc = builtinScene("city_facades", variant, t0);
+    sc.name = name;
+    sc.description += "; elevated structure seen over the first row of buildings (roof edges, "
+                      "rooftop plant, upper storeys, tree crowns in the blocks)";
+    const detail::CityLayout l;
+    detail::addElevatedDetail(sc.world, variant, l.grid, l.pitch_m, l.half_street_m);
     return sc;
   }
   if (name == "city_open") {  // city_facades' detail on a more open street grid (city_layout.hpp)

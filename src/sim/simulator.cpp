@@ -102,6 +102,7 @@ void Simulator::Impl::buildScatterers() {
     s.x = t.x;
     s.y = t.y;
     s.rcs_db = float(t.rcs);
+    s.elevated = t.elevated;
     if (t.vx != 0 || t.vy != 0) {
       // Without the moving_objects effect the static world is rendered: movers are left out.
       if (!physics.moving_objects) continue;

@@ -22,6 +22,7 @@ struct Scatterer {
   int32_t wall = -1;      ///< wall it belongs to (occlusion exemption), -1 = none
   int32_t mirror = -1;    ///< multipath ghost: wall it is mirrored in, -1 = direct
   float clutter_u = -1;   ///< textured clutter: shown where clutterDensityX(r) > this
+  bool elevated = false;  ///< Target::elevated: not occluded by walls (seen over them)
 };
 
 /// Effects beyond the named ones, read from PhysicsConfig::extra.

@@ -13,6 +13,10 @@ struct Target {
   double x = 0, y = 0;      ///< m
   double rcs = 10;          ///< dBsm
   double vx = 0, vy = 0;    ///< m/s (moving objects; extra key "vx","vy" in the JSON)
+  /// Seen over the walls (JSON key "elevated", default false): upper storeys, roof edges, tree
+  /// crowns that a roof-mounted radar sees over the first row of buildings. The 2-D depth map
+  /// would hide them behind the first wall hit, so they are exempt from it.
+  bool elevated = false;
 };
 
 struct Wall {
@@ -20,7 +24,7 @@ struct Wall {
   double rcs_per_m = 0;                   ///< dBsm per metre of wall
 };
 
-/// {"targets": [{"x","y","rcs"}], "walls": [{"x1","y1","x2","y2","rcs_per_m"}]} + extra keys.
+/// {"targets": [{"x","y","rcs"[,"vx","vy","elevated"]}], "walls": [{"x1","y1","x2","y2","rcs_per_m"}]} + extra keys.
 struct World {
   std::vector<Target> targets;
   std::vector<Wall> walls;

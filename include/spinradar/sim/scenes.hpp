@@ -6,6 +6,10 @@
 //   "city_facades" the same city (scatterer for scatterer, same route) plus facade detail and
 //                  street furniture: point scatterers that stay bright at grazing incidence,
 //                  the far structure of real streets (docs/city_scene_far_structure.md)
+//   "city_elevated" city_facades (target for target) plus elevated targets seen over the first
+//                  row of buildings: roof edges, rooftop plant, upper storeys, tree crowns
+//                  (docs/diagnose_elevated_structure.md)
+//   "city_open"    city_facades' detail on a more open street grid (city_layout.hpp)
 //   "out_and_back" a straight 1 km road with roadside structures, driven out at 10-20 m/s,
 //                  U-turn, and back on the other lane
 //   "tight_turns"  an open yard with poles, containers and walls; slalom and tight loops
