@@ -245,7 +245,12 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
       if (key_ramp_ || gap_step)
         gap = std::min(gap, std::abs((xi(2) - key_xi_(2)) - (pair.velocity(2) - key_pair_xi_(2))));
       const double sd = std::sqrt(cov_pub(5, 5) + pair.velocity_cov(2, 2));
-      if ((gap > kRegisteredYawRateGap && gap > config_.yaw_rate_sigmas * sd) || pair_ramp) {
+      // yaw_rate_map_check: the same difference again against the same keyframe, the pair's
+      // yaw rate steady, is the keyframe map's own yaw-rate error (mapRateBias), not motion.
+      const bool repeated = mapRateBias(xi(2) - pair.velocity(2));
+      const bool map_bias = config_.yaw_rate_map_check && !pair_ramp && repeated;
+      if ((gap > kRegisteredYawRateGap && gap > config_.yaw_rate_sigmas * sd && !map_bias) ||
+          pair_ramp) {
         xi_key = xi;
         xi_cov_pub = cov_pub.bottomRightCorner<3, 3>();
       } else {  // the pair velocity's error is its own, independent of the registered pose
@@ -390,6 +395,24 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
     C_jprev_ = C_jk;
     C_jprev_pub_ = C_pub;
   }
+}
+
+// A registration's yaw rate follows the keyframe map's: the map was moved to its mid-scan
+// time with the keyframe's velocity, and an error e of that yaw rate bends it so that every
+// scan registered to it comes out about e off (issue 19, docs/sensor_columns/
+// round19_map_rate_bias.md: a keyframe made at a turn entry, its map 0.1 rad/s off, then
+// registrations 0.12-0.19 rad/s under the pair's for the whole steady turn; taken as motion,
+// each published pose moved by up to 1.3 deg and the next keyframes' maps inherited it). A
+// yaw-rate step inside a scan shows in one registration first; a map's error shows again in
+// the next one against the same keyframe. So: the registered-minus-pair difference within
+// kRegisteredYawRateGap of the previous scan's against this keyframe is the map's.
+bool KeyframeTracker::mapRateBias(double offset) {
+  const bool repeat = has_rate_offset_ && rate_offset_key_ == key_stamp_ &&
+                      std::abs(offset - rate_offset_) < kRegisteredYawRateGap;
+  has_rate_offset_ = true;
+  rate_offset_ = offset;
+  rate_offset_key_ = key_stamp_;
+  return repeat;
 }
 
 }  // namespace spinradar

@@ -181,6 +181,10 @@ class KeyframeTracker : public KeyframeTuning {
   /// there (kRampYawAccel): the registered yaw rate's reference after such a keyframe.
   Eigen::Vector3d key_pair_xi_ = Eigen::Vector3d::Zero();
   bool key_ramp_ = false;
+  /// The last registration's yaw rate minus the pair's, and its keyframe (mapRateBias).
+  bool has_rate_offset_ = false;
+  double rate_offset_ = 0.0;
+  int64_t rate_offset_key_ = 0;
   int64_t key_stamp_ = 0, rel_key_stamp_ = 0;
   /// The keyframe's velocity covariance (published one): its map's own uncertainty.
   Eigen::Matrix3d key_xi_cov_ = Eigen::Matrix3d::Zero();
@@ -263,6 +267,9 @@ class KeyframeTracker : public KeyframeTuning {
   /// Whether o's points, placed with T_on (the new keyframe's frame in o's), agree with the new
   /// keyframe's (a rigid fit moves them by little); o is averaged only then (keyframe_map.cpp).
   bool submapAgrees(const SubmapFrame& o, const Eigen::Matrix3d& T_on) const;
+  /// Whether a registration's yaw rate minus the pair's (offset, rad/s) repeats the last
+  /// one against the same keyframe (the map's own yaw-rate error); records it.
+  bool mapRateBias(double offset);
   /// EstimatorConfig::keyframe_graph (keyframe_graph.cpp): a measured mid-scan pose Z of a
   /// keyframe relative to the earlier keyframe at stamp `to`, and its [x, y, yaw] covariance.
   struct GraphEdge {
