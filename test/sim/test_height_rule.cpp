@@ -133,6 +133,23 @@ TEST(SimHeightRule, WithoutFiniteWallsTheRuleIsTheDepthMap) {
     EXPECT_EQ(plain.renderScan(k).power, rule.renderScan(k).power) << "scan " << k;
 }
 
+// The same with multipath ghosts (their mirror-wall test) on a small street: two facades, a
+// car between, point targets on both sides.
+TEST(SimHeightRule, WithoutFiniteWallsGhostsAreTheDepthMaps) {
+  World w;
+  w.walls.push_back({-40, 8, 60, 8, 3.0});
+  w.walls.push_back({60, -8, -40, -8, 3.0});
+  w.walls.push_back({12, 4, 16, 4, 8.0});
+  for (int k = 0; k < 12; ++k) w.targets.push_back({-20.0 + 7 * k, k % 2 ? 5.5 : -6.0, 12.0, 0, 0});
+  w.targets.push_back({25, 12, 20.0, 0, 0});  // behind a facade
+  World grounded = w;
+  grounded.targets[3].height = 0.0;
+  PhysicsConfig p = fullPhysics();
+  p.extra["multipath"] = true;
+  Simulator plain(w, constantMotion(8, 0.05), SensorConfig{}, p, 2), rule(grounded, constantMotion(8, 0.05), SensorConfig{}, p, 2);
+  EXPECT_EQ(plain.renderScan(3).power, rule.renderScan(3).power);
+}
+
 // The world file: "height" written only when set (older worlds keep their bytes), read back;
 // negative, NaN and non-number heights refused with the key named, in a file with the file's name.
 TEST(SimHeightRule, WorldJson) {
