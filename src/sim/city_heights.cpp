@@ -10,6 +10,12 @@
 namespace spinradar::sim::detail {
 
 void addCityHeights(Scene& sc, uint64_t variant, bool elevated_structure, const CityHeights& p) {
+  sc.name = elevated_structure ? "city_heights" : "city_facades_heights";
+  sc.description += elevated_structure
+                        ? "; facade detail, street furniture and the elevated structure, with heights: "
+                          "each seen where it rises above the line of sight over what is in front"
+                        : "; facade detail and street furniture, with heights: buildings by their "
+                          "storeys, parked cars 1.5 m";
   World& w = sc.world;
   const CityLayout l;
   // The city's own targets: poles first, then the moving cars, then ground clutter and trees.

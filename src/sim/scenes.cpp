@@ -399,13 +399,7 @@ Scene builtinScene(const std::string& name, uint64_t variant, double t0) {
   }
   if (name == "city_heights" || name == "city_facades_heights") {  // heights (city_heights.hpp)
     Scene sc = city(variant, t0);
-    const bool elevated = name == "city_heights";
-    sc.name = name;
-    sc.description += elevated ? "; facade detail, street furniture and the elevated structure, with heights: "
-                                 "seen over what is lower than the line of sight (roof-mounted antenna)"
-                               : "; facade detail and street furniture, with heights: parked cars "
-                                 "1.5 m, buildings by their storeys";
-    detail::addCityHeights(sc, variant, elevated);
+    detail::addCityHeights(sc, variant, name == "city_heights");
     return sc;
   }
   if (name == "city_open") {  // city_facades' detail on a more open street grid (city_layout.hpp)
