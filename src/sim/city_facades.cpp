@@ -8,11 +8,14 @@
 
 namespace spinradar::sim::detail {
 
-void addFacadeDetail(World& w, uint64_t variant, int grid, double pitch, const FacadeDetail& p) {
+void addFacadeDetail(World& w, uint64_t variant, int grid, double pitch, const FacadeDetail& p,
+                     std::vector<double>* building_heights) {
   Rng rng(0xFACADE00ull + variant);  // its own stream: the city's draws stay as they are
   auto uni = [&](double a, double b) { return a + (b - a) * rng.uniform(); };
   const size_t n_walls = w.walls.size();  // targets are appended, walls never
   double stack_db = 0;  // storeys of the current building (a box's four walls are consecutive)
+  double top_m = 0;     // its height (only used with building_heights)
+  if (building_heights) building_heights->assign(n_walls, 0.0);
   for (size_t i = 0; i < n_walls; ++i) {
     const Wall wl = w.walls[i];
     const double ex = wl.x2 - wl.x1, ey = wl.y2 - wl.y1, len = std::hypot(ex, ey);
@@ -21,9 +24,15 @@ void addFacadeDetail(World& w, uint64_t variant, int grid, double pitch, const F
     if (i % 4 == 0) {
       const int floors = p.floors_min + int(rng.uniform() * (p.floors_max - p.floors_min + 1));
       stack_db = 10.0 * std::log10(double(std::min(floors, p.floors_max)));
+      top_m = std::min(floors, p.floors_max) * p.storey_m + p.roof_m;
+    }
+    if (building_heights) {
+      (*building_heights)[i] = top_m;
+      w.walls[i].height = top_m;
     }
     auto add = [&](double u, double d, double rcs) {
       w.targets.push_back({wl.x1 + u * ux + d * nx, wl.y1 + u * uy + d * ny, rcs, 0, 0});
+      if (building_heights) w.targets.back().height = top_m;
     };
     auto detail = [&] {
       return std::clamp(p.rcs_mean_db + p.rcs_sd_db * rng.normal(), p.rcs_lo_db, p.rcs_hi_db) + stack_db;
@@ -55,6 +64,7 @@ void addFacadeDetail(World& w, uint64_t variant, int grid, double pitch, const F
             w.targets.push_back({u, k * pitch + off, rcs, 0, 0});
           else
             w.targets.push_back({k * pitch + off, u, rcs, 0, 0});
+          if (building_heights) w.targets.back().height = p.furniture_height_m;
         }
 }
 

@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "glint.hpp"
+#include "height_rule.hpp"
 #include "simulator_impl.hpp"
 
 namespace spinradar::sim {
@@ -146,13 +148,17 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
   };
 
   // ---- occlusion: first wall along each fine angle, from the pose of the azimuth seeing it.
+  // With heights (height_rule.hpp) every wall hit is kept, for the skyline of each angle.
   const int J = N * kDepthOversample;
+  const double h_s = sensor.mount_height;
   w.depth.assign(J, 1e30);
   w.depth_wall.assign(J, -1);
+  w.hits.clear();
   const int probe[5] = {0, N / 4, N / 2, 3 * N / 4, N - 1};
   for (size_t wi = 0; wi < world.walls.size(); ++wi) {
     const Wall& wl = world.walls[wi];
     if (pointSegmentDistance(mx, my, wl) > r_max + travel) continue;
+    const double wall_h = wl.height ? *wl.height : std::numeric_limits<double>::infinity();
     double ref = bearingCw(wl.x1, wl.y1, mx, my, w.cyaw[a_mid], w.syaw[a_mid]);
     double lo = 0, hi = 0;
     for (int a : probe)
@@ -180,19 +186,23 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
       double dxw = w.cyaw[a] * c + w.syaw[a] * s;   // cos(yaw - psi)
       double dyw = w.syaw[a] * c - w.cyaw[a] * s;   // sin(yaw - psi)
       double t = raySegment(w.px[a], w.py[a], dxw, dyw, wl);
-      if (t > 0 && t < w.depth[j]) {
+      if (heights) {
+        if (t > 0) w.hits.push_back({uint32_t(j), int32_t(wi), t, detail::topSlope(wall_h, h_s, t)});
+      } else if (t > 0 && t < w.depth[j]) {
         w.depth[j] = t;
         w.depth_wall[j] = int32_t(wi);
       }
     }
   }
 
+  const double tol = sensor.occlusion_tolerance;
   w.wall_seen.assign(world.walls.size(), 0);
+  if (heights)  // a wall is rendered where its top shows over the walls in front
+    detail::buildSkylines(w, J, w.wall_seen);
   for (int j = 0; j < J; ++j)
     if (w.depth_wall[j] >= 0) w.wall_seen[w.depth_wall[j]] = 1;
 
   // ---- bucket scatterers by the azimuths whose beam can reach them.
-  const double tol = sensor.occlusion_tolerance;
   w.pairs.clear();
   const double noise_mid = model.thresholdLin(std::min(M - 1, M / 2));
   const double r_cull = r_max + travel;
@@ -220,9 +230,12 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
       double rr = std::hypot(x - w.px[a], y - w.py[a]);
       int j = std::min(J - 1, int(psi / kTwoPi * J));
       bool hidden = true;
+      const double slope = heights ? detail::topSlope(sc.height, h_s, rr) : 0.0;
       for (int dj = -1; dj <= 1 && hidden; ++dj) {
         int jj = (j + dj + J) % J;
-        if (w.depth_wall[jj] == sc.wall || rr <= w.depth[jj] + tol + 0.5) hidden = false;
+        if (heights ? detail::clearsWalls(w, jj, rr, slope, sc.wall, tol + 0.5)
+                    : (w.depth_wall[jj] == sc.wall || rr <= w.depth[jj] + tol + 0.5))
+          hidden = false;
       }
       if (hidden) return;
     }
@@ -321,11 +334,22 @@ void Simulator::Impl::render(double t0, uint64_t scan_key, PolarScan& out) const
       if (psi >= kTwoPi) psi -= kTwoPi;
       int j = std::min(J - 1, int(psi * (J / kTwoPi)));
       if (sc.mirror >= 0) {
-        // A ghost shows through its mirror wall only, and only if that hit is not occluded.
-        double th = raySegment(px, py, dx / r, dy / r, world.walls[sc.mirror]);
-        if (th < 0 || (w.depth_wall[j] != sc.mirror && th > w.depth[j] + tol)) continue;
-      } else if (!sc.elevated && w.depth_wall[j] != sc.wall && r > w.depth[j] + tol) {
-        continue;
+        // A ghost shows through its mirror wall only, and only if that hit is not occluded
+        // (with heights: the mirror wall's top at the hit clears the walls in front).
+        const Wall& mw = world.walls[sc.mirror];
+        double th = raySegment(px, py, dx / r, dy / r, mw);
+        if (th < 0) continue;
+        if (heights) {
+          const double mh = mw.height ? *mw.height : std::numeric_limits<double>::infinity();
+          if (!detail::clearsWalls(w, j, th, detail::topSlope(mh, h_s, th), sc.mirror, tol)) continue;
+        } else if (w.depth_wall[j] != sc.mirror && th > w.depth[j] + tol) {
+          continue;
+        }
+      } else if (!sc.elevated) {
+        const bool hidden =
+            heights ? !detail::clearsWalls(w, j, r, detail::topSlope(sc.height, h_s, r), sc.wall, tol)
+                    : (w.depth_wall[j] != sc.wall && r > w.depth[j] + tol);
+        if (hidden) continue;
       }
       double p = double(sc.rcs_lin) * model.rangeFactor(r) * g;
       if (sc.wall >= 0) {

@@ -74,6 +74,7 @@ World World::fromJson(const nlohmann::json& j) {
         if (!e->is_boolean()) throw JsonPathError(path, "must be true or false");
         t.elevated = e->get<bool>();
       }
+      if (o.contains("height")) t.height = number(o, at, "height", true, 0, 0, 1000);
       w.targets.push_back(t);
     }
   }
@@ -88,6 +89,7 @@ World World::fromJson(const nlohmann::json& j) {
       wl.x2 = number(o, at, "x2", true, 0, -1e7, 1e7);
       wl.y2 = number(o, at, "y2", true, 0, -1e7, 1e7);
       wl.rcs_per_m = number(o, at, "rcs_per_m", true, 0, -100, 100);
+      if (o.contains("height")) wl.height = number(o, at, "height", true, 0, 0, 1000);
       if (std::hypot(wl.x2 - wl.x1, wl.y2 - wl.y1) < 1e-6)
         throw JsonPathError(at, "wall has zero length");
       w.walls.push_back(wl);
@@ -106,13 +108,24 @@ nlohmann::json World::toJson() const {
       o["vy"] = t.vy;
     }
     if (t.elevated) o["elevated"] = true;  // written only when set: older worlds keep their bytes
+    if (t.height) o["height"] = *t.height;
     j["targets"].push_back(o);
   }
   j["walls"] = nlohmann::json::array();
-  for (const auto& w : walls)
-    j["walls"].push_back(
-        {{"x1", w.x1}, {"y1", w.y1}, {"x2", w.x2}, {"y2", w.y2}, {"rcs_per_m", w.rcs_per_m}});
+  for (const auto& w : walls) {
+    nlohmann::json o{{"x1", w.x1}, {"y1", w.y1}, {"x2", w.x2}, {"y2", w.y2}, {"rcs_per_m", w.rcs_per_m}};
+    if (w.height) o["height"] = *w.height;
+    j["walls"].push_back(o);
+  }
   return j;
+}
+
+bool World::hasHeights() const {
+  for (const auto& t : targets)
+    if (t.height) return true;
+  for (const auto& w : walls)
+    if (w.height) return true;
+  return false;
 }
 
 World World::load(const std::string& path) {

@@ -7,6 +7,7 @@
 
 #include "spinradar/sim/city_elevated.hpp"
 #include "spinradar/sim/city_facades.hpp"
+#include "spinradar/sim/city_heights.hpp"
 #include "spinradar/sim/city_layout.hpp"
 #include "render_model.hpp"
 
@@ -372,7 +373,8 @@ Scene tightTurns(uint64_t variant, double t0) {
 }  // namespace
 
 std::vector<std::string> builtinSceneNames() {
-  return {"city", "city_elevated", "city_facades", "city_open", "out_and_back", "tight_turns"};
+  return {"city", "city_elevated", "city_facades", "city_facades_heights", "city_heights",
+          "city_open", "out_and_back", "tight_turns"};
 }
 
 Scene builtinScene(const std::string& name, uint64_t variant, double t0) {
@@ -393,6 +395,11 @@ Scene builtinScene(const std::string& name, uint64_t variant, double t0) {
                       "rooftop plant, upper storeys, tree crowns in the blocks)";
     const detail::CityLayout l;
     detail::addElevatedDetail(sc.world, variant, l.grid, l.pitch_m, l.half_street_m);
+    return sc;
+  }
+  if (name == "city_heights" || name == "city_facades_heights") {  // heights (city_heights.hpp)
+    Scene sc = city(variant, t0);
+    detail::addCityHeights(sc, variant, name == "city_heights");
     return sc;
   }
   if (name == "city_open") {  // city_facades' detail on a more open street grid (city_layout.hpp)

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 
 #include "simulator_impl.hpp"
@@ -74,6 +75,7 @@ Simulator::Impl::Impl(World w, Trajectory t, SensorConfig s, PhysicsConfig p, ui
       sensor(checked(std::move(s))),
       physics(p.withSensorPhysics(sensor.physics)),
       seed(sd),
+      heights(world.hasHeights()),
       fx(detail::ExtraEffects::from(physics)),
       model(sensor) {
   if (traj.samples().size() < 2) throw std::invalid_argument("simulator: empty trajectory");
@@ -103,6 +105,7 @@ void Simulator::Impl::buildScatterers() {
     s.y = t.y;
     s.rcs_db = float(t.rcs);
     s.elevated = t.elevated;
+    s.height = float(t.height.value_or(0.0));
     if (t.vx != 0 || t.vy != 0) {
       // Without the moving_objects effect the static world is rendered: movers are left out.
       if (!physics.moving_objects) continue;
@@ -137,6 +140,7 @@ void Simulator::Impl::buildScatterers() {
       s.nx = float(-ey / len);
       s.ny = float(ex / len);
       s.wall = int32_t(wi);
+      s.height = w.height ? float(*w.height) : std::numeric_limits<float>::infinity();
       statics.push_back(s);
     }
   }

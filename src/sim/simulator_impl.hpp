@@ -23,6 +23,10 @@ struct Scatterer {
   int32_t mirror = -1;    ///< multipath ghost: wall it is mirrored in, -1 = direct
   float clutter_u = -1;   ///< textured clutter: shown where clutterDensityX(r) > this
   bool elevated = false;  ///< Target::elevated: not occluded by walls (seen over them)
+  /// m above the ground, for the height rule (Impl::heights only): Target::height (unset 0),
+  /// a wall scatterer its wall's height (unset = infinity: the wall is hidden only by walls
+  /// that are infinitely tall too, as in the plain depth map).
+  float height = 0;
 };
 
 /// Effects beyond the named ones, read from PhysicsConfig::extra.
@@ -52,6 +56,23 @@ struct ScanWork {
   std::vector<double> depth;
   std::vector<int32_t> depth_wall;
   std::vector<uint8_t> wall_seen;  // wall is the first hit of at least one angle bin
+  // Height rule (worlds with heights, height_rule.hpp): every wall hit per occlusion angle bin,
+  // then per bin the skyline of the walls' tops as seen from the sensor (CSR, reused).
+  struct Hit {
+    uint32_t j;
+    int32_t wall;
+    double t, slope;
+  };
+  std::vector<Hit> hits, hits_sorted;
+  std::vector<uint32_t> hit_start;
+  std::vector<uint32_t> sky_start;
+  struct Step {
+    double t;      ///< distance of the wall that raises the skyline
+    double top;    ///< largest (H - h_s) / d of the walls up to and including it
+    double below;  ///< the same without it (the scatterers of that wall itself)
+    int32_t wall;
+  };
+  std::vector<Step> sky;
   std::vector<uint64_t> pairs;  // (azimuth << 32) | scatterer index (movers: | 1 << 31)
   std::vector<uint32_t> bucket_start, bucket_items;
   std::vector<float> row;
@@ -67,6 +88,7 @@ struct Simulator::Impl {
   SensorConfig sensor;
   PhysicsConfig physics;
   uint64_t seed;
+  bool heights = false;  ///< world.hasHeights(): the height rule instead of the plain depth map
   detail::ExtraEffects fx;
   detail::RenderModel model;
   /// Odd azimuths' range response when range_psf_odd_ratio != 1 (alternating chirps of unequal

@@ -94,7 +94,7 @@ void serve(const ServeOptions& o) {
 SPINRADAR_COMMAND("serve", "Serve a simulated scene as a live Navtech radar (TCP protocol) on a loopback port",
                   [](CLI::App& app) {
                     auto o = std::make_shared<ServeOptions>();
-                    app.add_option("--scene", o->scene, "Built-in scene: city, city_elevated, city_facades, city_open, out_and_back or tight_turns")
+                    app.add_option("--scene", o->scene, "Built-in scene: city, city_elevated, city_facades, city_facades_heights, city_heights, city_open, out_and_back or tight_turns")
                         ->capture_default_str();
                     app.add_option("--port", o->port, "TCP port (Navtech default 6317; 0 = any free port)")
                         ->capture_default_str()

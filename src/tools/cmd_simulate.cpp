@@ -103,7 +103,7 @@ SPINRADAR_COMMAND("simulate", "Simulate a recording (Oxford polar PNGs + true tr
                   [](CLI::App& app) {
                     auto o = std::make_shared<SimulateOptions>();
                     app.add_option("--scene", o->scene,
-                                   "Built-in scene: city, city_elevated, city_facades, city_open, out_and_back, tight_turns");
+                                   "Built-in scene: city, city_elevated, city_facades, city_facades_heights, city_heights, city_open, out_and_back, tight_turns");
                     app.add_option("--world", o->world, "World JSON file");
                     app.add_option("--trajectory", o->trajectory, "Trajectory CSV (t,x,y,yaw)");
                     app.add_option("--physics", o->physics,

@@ -7,6 +7,7 @@
 // Added on top of "city_facades" with its own random stream, appended: every earlier target
 // keeps its place and value, and "city" / "city_facades" are untouched.
 #include <cstdint>
+#include <vector>
 
 #include "spinradar/sim/scene.hpp"
 
@@ -50,14 +51,23 @@ struct ElevatedDetail {
   int crown_points_max = 25;        ///<   the crown's disc
   double crown_rcs_mean_db = -15.0; ///< per scatterer, normal(mean, sd): a crown face of ~15 m^2
   double crown_rcs_sd_db = 5.0;     ///<   at sigma0 ~ -15 dB is ~ -3 dBsm, over ~16 scatterers
+  // Heights in place of the flag ("city_heights", docs/diagnose_height_visibility.md):
+  double upper_below_top_m = 1.5;   ///< upper-storey detail: the top storey's windows
+  double plant_above_top_m = 1.5;   ///< rooftop plant stands this far above the roof
+  double crown_height_per_radius = 3.0;  ///< crown top = 3 x radius: 6-12 m for 2-4 m crowns
 };
 
 /// Adds the elevated structure to `w` (the city world of `grid` x `grid` blocks of `pitch` m,
 /// streets 2 `half_street` m wide): for every building box (four consecutive walls, the
 /// city's boxes counter-clockwise, outward normal of (x1,y1)->(x2,y2) is (dy, -dx)) its roof
 /// edge, rooftop plant and upper-storey detail; tree crowns in every block. Every added target
-/// is elevated. Deterministic in `variant`.
+/// is elevated. Deterministic in `variant`. With `building_heights` (per wall index, from
+/// addFacadeDetail) the added targets carry heights instead of the flag, and the renderer's
+/// height rule decides what shows over what: roof edge at the building's top, upper-storey
+/// detail upper_below_top_m below it, plant plant_above_top_m above it, crowns
+/// crown_height_per_radius x radius. The draws are the same.
 void addElevatedDetail(World& w, uint64_t variant, int grid, double pitch, double half_street,
-                       const ElevatedDetail& p = ElevatedDetail{});
+                       const ElevatedDetail& p = ElevatedDetail{},
+                       const std::vector<double>* building_heights = nullptr);
 
 }  // namespace spinradar::sim::detail

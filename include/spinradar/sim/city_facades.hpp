@@ -6,6 +6,7 @@
 // street. Added on top of the "city" world with its own random stream: the rest of the scene is
 // the same scatterer for scatterer, and "city" itself is untouched.
 #include <cstdint>
+#include <vector>
 
 #include "spinradar/sim/scene.hpp"
 
@@ -48,14 +49,22 @@ struct FacadeDetail {
   double furniture_rcs_min_db = -5.0;  ///< dBsm, uniform
   double furniture_rcs_max_db = 12.0;
   double junction_clear_m = 9.0;   ///< no furniture this close to a crossing's centre line
+  // Heights (only when asked for, "city_heights"; docs/diagnose_height_visibility.md):
+  double storey_m = 3.0;           ///< building height = floors * storey_m + roof_m (the same
+  double roof_m = 1.0;             ///<   floors as the detail's stacking): 7-16 m
+  double furniture_height_m = 2.5; ///< signs, posts, bus shelters: above a parked car's roof
 };
 
 /// Adds the facade detail to `w` (the city world of `grid` x `grid` blocks of `pitch` m): details
 /// and roughness in front of every building wall (walls of at least min_wall_m; the city's boxes are drawn
 /// counter-clockwise, so the outward normal of wall (x1,y1)->(x2,y2) is (dy, -dx)), a scatterer
 /// at each building corner, and street furniture along every street, junctions kept clear.
-/// Deterministic in `variant`.
+/// Deterministic in `variant`. With `building_heights`, every wall of a building gets its
+/// height (floors * storey_m + roof_m; other walls left unset, their entry 0), written there by
+/// wall index, and every added target a height: the facade detail its building's top (it stands
+/// for the detail of all its storeys), the furniture furniture_height_m. The draws are the same.
 void addFacadeDetail(World& w, uint64_t variant, int grid, double pitch,
-                     const FacadeDetail& p = FacadeDetail{});
+                     const FacadeDetail& p = FacadeDetail{},
+                     std::vector<double>* building_heights = nullptr);
 
 }  // namespace spinradar::sim::detail

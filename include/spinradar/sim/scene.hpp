@@ -1,6 +1,7 @@
 #pragma once
 // Scene (world JSON) and sensor trajectory (t,x,y,yaw CSV): the simulator's file interfaces.
 // World frame REP 103: x, y in metres, yaw CCW in radians.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,19 +18,34 @@ struct Target {
   /// crowns that a roof-mounted radar sees over the first row of buildings. The 2-D depth map
   /// would hide them behind the first wall hit, so they are exempt from it.
   bool elevated = false;
+  /// Height of the scatterer above the ground, m (JSON key "height", optional, 0..1000). Unset =
+  /// on the ground (0). Used by the visibility rule against walls that have a height (render:
+  /// seen over a wall crossing the line of sight at distance d < r iff
+  /// (height - mount_height) * d > (wall height - mount_height) * r); a wall without a height
+  /// is infinitely tall and hides it as before. "elevated" wins over it.
+  std::optional<double> height;
 };
 
 struct Wall {
   double x1 = 0, y1 = 0, x2 = 0, y2 = 0;  ///< m
   double rcs_per_m = 0;                   ///< dBsm per metre of wall
+  /// Top of the wall above the ground, m (JSON key "height", optional, 0..1000). Unset =
+  /// infinitely tall: it hides everything behind it (the 2-D depth map, as before). A wall lower
+  /// than the sensor (a parked car) hides only what lies below the line from the sensor over it.
+  std::optional<double> height;
 };
 
-/// {"targets": [{"x","y","rcs"[,"vx","vy","elevated"]}], "walls": [{"x1","y1","x2","y2","rcs_per_m"}]} + extra keys.
+/// {"targets": [{"x","y","rcs"[,"vx","vy","elevated","height"]}],
+///  "walls": [{"x1","y1","x2","y2","rcs_per_m"[,"height"]}]} + extra keys. Optional keys are
+/// written only when set, so worlds without them keep their bytes.
 struct World {
   std::vector<Target> targets;
   std::vector<Wall> walls;
   static World fromJson(const nlohmann::json& j);  ///< throws std::runtime_error with the key
   nlohmann::json toJson() const;
+  /// Any wall or target with a height: the renderer then applies the height rule (otherwise
+  /// the plain depth map, byte for byte as before heights existed).
+  bool hasHeights() const;
   static World load(const std::string& path);      ///< errors name the file
   void save(const std::string& path) const;
 };

@@ -9,6 +9,11 @@
 //   "city_elevated" city_facades (target for target) plus elevated targets seen over the first
 //                  row of buildings: roof edges, rooftop plant, upper storeys, tree crowns
 //                  (docs/diagnose_elevated_structure.md)
+//   "city_facades_heights" city_facades item for item with heights (buildings by storeys,
+//                  parked cars 1.5 m): the renderer's height rule instead of walls that hide
+//                  everything (docs/diagnose_height_visibility.md, city_heights.hpp)
+//   "city_heights" city_facades_heights plus city_elevated's structure with heights instead of
+//                  the "elevated" flag
 //   "city_open"    city_facades' detail on a more open street grid (city_layout.hpp)
 //   "out_and_back" a straight 1 km road with roadside structures, driven out at 10-20 m/s,
 //                  U-turn, and back on the other lane

@@ -48,6 +48,7 @@
   X(double, wall_spacing, 0.25, 0.02, 5.0, "m", "Spacing of the scatterers a wall is rendered with") \
   X(double, wall_texture_db, 5.0, 0.0, 20.0, "dB", "Std of the per-scatterer facade texture") \
   X(double, occlusion_tolerance, 0.25, 0.0, 5.0, "m", "Scatterers this far behind the first wall still show") \
+  X(double, mount_height, 2.0, 0.0, 50.0, "m", "Height of the antenna above the ground: a wall of a world's 'height' hides a target behind it only below the line from here over its top (no effect on worlds without heights)") \
   X(double, render_threshold_db, -6.0, -40.0, 20.0, "dB", "Contributions below noise floor + this are skipped") \
   X(double, stc_curve_db_5m, 0.0, -40.0, 40.0, "dB", "Range gain curve (STC) correction at 5 m, on noise and returns (curves: linear in log range between 5, 16, 35, 71 m, flat outside)") \
   X(double, stc_curve_db_16m, 0.0, -40.0, 40.0, "dB", "Range gain curve (STC) correction at 16 m, on noise and returns") \
