@@ -78,8 +78,17 @@ for s in city out_and_back tight_turns; do
 done
 
 # serve: says which scene it serves (stopped after a moment).
-serve_scene() {  # serve args... -> the scene it announced
-  timeout 4 "$bin" serve --port 0 "$@" 2> "$out/serve.log" > /dev/null || true
+serve_scene() {  # serve args... -> the scene it announced (waits up to 120 s, then stops it)
+  : > "$out/serve.log"
+  "$bin" serve --port 0 "$@" 2> "$out/serve.log" > /dev/null &
+  local pid=$! k
+  for k in $(seq 240); do
+    grep -q "^serve: scene" "$out/serve.log" && break
+    kill -0 "$pid" 2> /dev/null || break
+    sleep 0.5
+  done
+  kill "$pid" 2> /dev/null || true
+  wait "$pid" 2> /dev/null || true
   sed -n "s/^serve: scene '\([a-z_]*\)'.*/\1/p" "$out/serve.log" | head -1
 }
 [[ "$(serve_scene --sensor oxford)" == city_heights ]] || { cat "$out/serve.log"; fail "serve did not take the reference scene"; }
@@ -87,18 +96,28 @@ serve_scene() {  # serve args... -> the scene it announced
 [[ "$(serve_scene --sensor "$out/nokey.json")" == city ]] || fail "serve without the key is not city"
 
 # diagnose: the appearance stage re-simulates the reference scene by default and writes the
-# scene it ran in into sensor_fitted.json; an own-scene fit writes no key.
+# scene it ran in into sensor_fitted.json; an own-scene fit writes no key. On a small sensor
+# (100 azimuths, 600 bins; the stage takes the recording's geometry) to keep the test short.
+/usr/bin/env python3 - "$ox" "$out/small.json" "$out/small_nokey.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+j.update(azimuths=100, bins=600)
+json.dump(j, open(sys.argv[2], "w"), indent=1, sort_keys=True)
+del j["reference_scene"]
+json.dump(j, open(sys.argv[3], "w"), indent=1, sort_keys=True)
+PY
+sim --sensor "$out/small.json" --out "$out/small_rec" 2> /dev/null
 diag() {  # name args...
   local name="$1"; shift
-  "$bin" diagnose --recording "$out/default/radar" --appearance-iterations 0 \
+  "$bin" diagnose --recording "$out/small_rec/radar" --appearance-iterations 0 \
     --appearance-curve-iterations 0 --appearance-curve-starts 1 --appearance-scans 1 \
     --appearance-no-holdout --out "$out/$name" "$@" > "$out/$name.log" 2>&1 \
     || { cat "$out/$name.log"; fail "diagnose $name failed"; }
   /usr/bin/env python3 -c 'import json,sys; print(json.load(open(sys.argv[1])).get("reference_scene", "-"))' \
     "$out/$name/appearance/sensor_fitted.json"
 }
-[[ "$(diag d_default --sensor oxford)" == city_heights ]] || fail "diagnose did not default to the reference scene"
-[[ "$(diag d_city --sensor oxford --appearance-scene city)" == city ]] || fail "diagnose --appearance-scene city did not win"
-[[ "$(diag d_nokey --sensor "$out/nokey.json")" == city ]] || fail "diagnose without the key is not city"
-[[ "$(diag d_own --sensor oxford --appearance-scene recording)" == - ]] || fail "an own-scene fit wrote a reference scene"
+[[ "$(diag d_default --sensor "$out/small.json")" == city_heights ]] || fail "diagnose did not default to the reference scene"
+[[ "$(diag d_city --sensor "$out/small.json" --appearance-scene city)" == city ]] || fail "diagnose --appearance-scene city did not win"
+[[ "$(diag d_nokey --sensor "$out/small_nokey.json")" == city ]] || fail "diagnose without the key is not city"
+[[ "$(diag d_own --sensor "$out/small.json" --appearance-scene recording)" == - ]] || fail "an own-scene fit wrote a reference scene"
 echo "ok: reference_scene"
