@@ -2,7 +2,9 @@
 """Before/after realism table of the calibrated sensors (README "Calibrated sensors",
 docs/diagnose.md) from the appearance reports scripts/calibrate_sensors.sh writes.
 
-Usage: scripts/appearance_table.py OUT   (OUT/<sample>/appearance/appearance.json)
+Usage: scripts/appearance_table.py OUT [SAMPLE ...]   (OUT/<sample>/appearance/appearance.json;
+SAMPLE: oxford, mulran, boreas_rt, radiate, default all four: one sample's column alone, e.g. a
+refit run on its own)
 Prints a markdown table (real fit part / real held out / sim before / sim after per sample) and,
 per sample and part, the fitted figures still over 15 % after the fit.
 """
@@ -49,9 +51,14 @@ def worst(g, far_only=False):
 
 
 def main():
-    if len(sys.argv) != 2:
+    if len(sys.argv) < 2:
         sys.exit(__doc__)
-    reps = [(label, load(sys.argv[1], name)) for name, label in SAMPLES]
+    known = [name for name, _ in SAMPLES]
+    for name in sys.argv[2:]:
+        if name not in known:
+            sys.exit(f"{name}: not a sample ({', '.join(known)})")
+    samples = [(n, l) for n, l in SAMPLES if len(sys.argv) == 2 or n in sys.argv[2:]]
+    reps = [(label, load(sys.argv[1], name)) for name, label in samples]
     parts = [("recording_fit", "fit part"), ("recording_holdout", "held-out part")]
     print("| figure: real fit part / real held out / sim before / sim after | " +
           " | ".join(label for label, _ in reps) + " |")
@@ -92,7 +99,7 @@ def main():
     print()
     # The recording's own split-half difference |held out - fit part| / fit part per figure,
     # next to each gap: a held-out gap of that size is the sample's own scatter (still not met).
-    for (name, label), (_, j) in zip(SAMPLES, reps):
+    for (name, label), (_, j) in zip(samples, reps):
         halves = (gaps(j, "recording_fit", "recording_holdout")
                   if "recording_holdout" in j["realism_bands"] else {})
         for part, what in parts:

@@ -5,8 +5,12 @@
 # Usage: scripts/calibrate_sensors.sh OUT [REALDATA]   (REALDATA defaults to ../shared/realdata)
 # Needs the built CLI (scripts/cli_path.sh); about 20 minutes on one core with one start of the range curves (several times that with the default 3, --appearance-curve-starts), most of it Boreas-RT
 # (6848 bins). Each sample's report: OUT/<sample>/appearance/appearance.md.
-# Env: APPEARANCE_SCENE (the reference world of the fit, default city; city_facades: the city
-# with the far structure of real streets, docs/city_scene_far_structure.md); APPEARANCE_HOLD
+# Env: APPEARANCE_SCENE (the reference world of every sample's fit, in place of its own: Oxford
+# city_heights, the city with building, car and tree heights, docs/diagnose_height_visibility.md;
+# the others city; city_facades: the city with the far structure of real streets,
+# docs/city_scene_far_structure.md). diagnose writes the scene into each file as its
+# "reference_scene" key, which simulate / serve / realism / the evaluation matrix then render
+# the file in; APPEARANCE_HOLD
 # (clutter: hold the clutter field at the start model's, i.e. off from the defaults, and fit the
 # sensor terms only; docs/diagnose_hold_clutter.md); RENDER_SEEDS (noise seeds of the before /
 # after figures, --render-seeds: means with their range) and FIT_SEEDS (noise seeds of the
@@ -20,17 +24,23 @@ cli="$(spinradar_cli_path "$root")"
 [ -n "$cli" ] || { echo "no built spinradar CLI under $root/build (scripts/build.sh)" >&2; exit 1; }
 [ -d "$data" ] || { echo "$data: no real data samples (see /work/shared/realdata/README.md)" >&2; exit 1; }
 mkdir -p "$out"
-run() {  # name, diagnose arguments...
-  local name="$1"; shift
-  echo "== $name" >&2
-  "$cli" diagnose "$@" --appearance-scene "${APPEARANCE_SCENE:-city}" ${APPEARANCE_HOLD:+--appearance-hold "$APPEARANCE_HOLD"} ${RENDER_SEEDS:+--render-seeds "$RENDER_SEEDS"} ${FIT_SEEDS:+--appearance-fit-seeds "$FIT_SEEDS"} --out "$out/$name" > "$out/$name.log" 2>&1 \
+run() {  # name, scene, diagnose arguments...
+  local name="$1" scene="${APPEARANCE_SCENE:-$2}"; shift 2
+  echo "== $name ($scene)" >&2
+  "$cli" diagnose "$@" --appearance-scene "$scene" ${APPEARANCE_HOLD:+--appearance-hold "$APPEARANCE_HOLD"} ${RENDER_SEEDS:+--render-seeds "$RENDER_SEEDS"} ${FIT_SEEDS:+--appearance-fit-seeds "$FIT_SEEDS"} --out "$out/$name" > "$out/$name.log" 2>&1 \
     || { echo "$name: diagnose failed, see $out/$name.log" >&2; exit 1; }
   local fitted="$out/$name/appearance/sensor_fitted.json"
   cp "$fitted" "$root/config/sensors/$name.json.tmp"
   mv "$root/config/sensors/$name.json.tmp" "$root/config/sensors/$name.json"
 }
-run oxford --recording "$data/oxford_2019-01-10-14-36-48/radar"
-run mulran --recording "$data/mulran" --format mulran --range-resolution 0.0595238
-run boreas_rt --recording "$data/boreas_rt" --format boreas --range-resolution 0.04381
-run radiate --recording "$data/radiate_fog_6_0/Navtech_Polar" --format auto --range-resolution 0.17361
+# Oxford's shipped file is the height round's H3 (docs/diagnose_height_visibility.md): the
+# file before it, refitted in city_heights with the far slope released, 8 fit seeds. With the
+# default model as start the fit lands elsewhere; OXFORD_START (a sensor file) reproduces H3
+# from the file it started from (git show e6a8975:config/sensors/oxford.json; with FIT_SEEDS=8,
+# RENDER_SEEDS=8 as H3 was run).
+run oxford city_heights --recording "$data/oxford_2019-01-10-14-36-48/radar" \
+  ${OXFORD_START:+--sensor "$OXFORD_START" --appearance-iterations 0 --appearance-curve-starts 1 --appearance-fit-far-slope}
+run mulran city --recording "$data/mulran" --format mulran --range-resolution 0.0595238
+run boreas_rt city --recording "$data/boreas_rt" --format boreas --range-resolution 0.04381
+run radiate city --recording "$data/radiate_fog_6_0/Navtech_Polar" --format auto --range-resolution 0.17361
 python3 "$root/scripts/appearance_table.py" "$out"

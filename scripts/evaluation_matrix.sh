@@ -28,7 +28,9 @@
 #      LAYOUT_COLS (columns also run on street layouts 1 and 2, default city_wide city_narrow
 #      city_oxford city_mulran; "" for none),
 #      CITY_SCENE (the built-in scene of every city_* column, default city; city_facades adds
-#      the far structure of real streets, docs/city_scene_far_structure.md).
+#      the far structure of real streets, docs/city_scene_far_structure.md), except the
+#      calibrated columns (city_<sensor>, city_oxford_glint0.14) of a file with a
+#      "reference_scene" key, which render in that scene (Oxford: city_heights).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="${1:-$root/build/evaluation_matrix}"
@@ -111,18 +113,40 @@ cols_spec=(
   "city_oxford_glint0.14|$city|0|@oxford|1|no|\"glint\": 0.14, \"glint_across\": 0, \"glint_along\": 0, \"azimuth_jitter\": 0"
   "out_and_back_glint0.18|out_and_back|0|{}|1|yes|\"glint\": 0.18"
 )
-# "@name": the calibrated model config/sensors/name.json.
+# A calibrated file is rendered in the scene it was calibrated in, its "reference_scene" key
+# (include/spinradar/sim/reference_scene.hpp: Oxford's fit takes the 16 m returns 8 dB down
+# because the facades behind the parked cars show in city_heights; in city they do not).
+# CITY_SCENE applies to the files without the key and to the non-calibrated city columns.
+sensor_scene() {  # sensor JSON file -> its reference_scene, else $city
+  /usr/bin/env python3 - "$1" "$city" <<'PY'
+import json, re, sys
+path, fallback = sys.argv[1], sys.argv[2]
+try:
+    with open(path) as f:
+        j = json.load(f)
+except (OSError, ValueError) as e:
+    sys.exit(f"error: {path}: cannot read the sensor file ({e})")
+if not isinstance(j, dict):
+    sys.exit(f"error: {path}: not a JSON object")
+s = j.get("reference_scene", fallback)
+if not isinstance(s, str) or not re.fullmatch(r"[a-z][a-z0-9_]*", s):
+    sys.exit(f"error: {path}: reference_scene: {s!r} is not a scene name")
+print(s)
+PY
+}
+# "@name": the calibrated model config/sensors/name.json, in its reference scene.
 for i in "${!cols_spec[@]}"; do
-  IFS='|' read -r _ _ _ sensor _ _ _ <<< "${cols_spec[$i]}"
+  IFS='|' read -r label scene variant sensor clutter held extra <<< "${cols_spec[$i]}"
   if [[ "$sensor" == @* ]]; then
     f="$root/config/sensors/${sensor#@}.json"
-    [[ -f "$f" ]] || { echo "error: $f not found (column ${cols_spec[$i]%%|*})" >&2; exit 1; }
-    cols_spec[$i]="${cols_spec[$i]/|$sensor|/|$(tr -d '\n' < "$f")|}"
+    [[ -f "$f" ]] || { echo "error: $f not found (column $label)" >&2; exit 1; }
+    [[ "$scene" == "$city" ]] && scene="$(sensor_scene "$f")"
+    cols_spec[$i]="$label|$scene|$variant|$(tr -d '\n' < "$f")|$clutter|$held${extra:+|$extra}"
   fi
 done
 for f in "$root"/config/sensors/*.json; do
   [[ -f "$f" ]] || continue
-  cols_spec+=("city_$(basename "$f" .json)|$city|0|$(tr -d '\n' < "$f")|1|no")
+  cols_spec+=("city_$(basename "$f" .json)|$(sensor_scene "$f")|0|$(tr -d '\n' < "$f")|1|no")
 done
 # Layouts: some sensor columns again on two other street layouts of their scene (--variant 1, 2),
 # as <label>_v1 / _v2, printed in a table of their own (LAYOUT_COLS="" leaves them out).

@@ -24,6 +24,12 @@ add_test(NAME cli_eval_short_sequence
 set_tests_properties(cli_eval_short_sequence PROPERTIES
   PASS_REGULAR_EXPRESSION "frame-to-frame errors \\(2\\)")
 
+# A calibrated sensor file's reference_scene: the default scene of simulate / serve / realism /
+# diagnose, an explicit --scene wins, bad values named, files without it as before.
+add_test(NAME cli_reference_scene
+  COMMAND bash ${_tt}/reference_scene.sh ${_cli} ${_out}/reference_scene ${PROJECT_SOURCE_DIR})
+set_tests_properties(cli_reference_scene PROPERTIES TIMEOUT 600)
+
 # Every bad input of every class gives a named error and loses nothing (issue 17): one table of
 # rows over all subcommands, inputs built from the simulator (test/tools/bad_inputs.sh).
 add_test(NAME cli_bad_inputs COMMAND bash ${_tt}/bad_inputs.sh ${_cli} ${_out}/bad_inputs)

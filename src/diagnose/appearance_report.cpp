@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "appearance_detail.hpp"
+#include "spinradar/sim/reference_scene.hpp"
 #include "markdown_table.hpp"
 #include "spinradar/evaluation/plot.hpp"
 
@@ -258,7 +259,14 @@ void writeAppearanceReport(const AppearanceReport& rep, const std::vector<PolarS
     writeText(d / "appearance.json", r.toJson().dump(2) + "\n");
     writeText(d / "appearance.md", r.summaryMarkdown());
   }
-  rep.fitted.save((d / "sensor_fitted.json").string());
+  {
+    // The fitted file names the scene it was calibrated in (reference_scene.hpp), so it renders
+    // there by default. A fit against the recording's own returns ("recording", "combined") has
+    // no built-in scene to name: the key is dropped, not inherited from the starting file.
+    sim::SensorConfig fitted = rep.fitted;
+    fitted.reference_scene = sim::isBuiltinScene(opt.scene) ? opt.scene : "";
+    fitted.save((d / "sensor_fitted.json").string());
+  }
   rep.fitted_physics.save((d / "physics_fitted.json").string());
 
   const auto before = renderReference(rep.base, rep.base_physics, opt, opt.seed + 1);

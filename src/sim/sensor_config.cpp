@@ -12,6 +12,7 @@
 
 #include "file_errors.hpp"
 #include "spinradar/sim/physics.hpp"
+#include "spinradar/sim/reference_scene.hpp"
 #include "spinradar/core/param_check.hpp"
 
 namespace spinradar::sim {
@@ -22,6 +23,13 @@ void SensorConfig::validate() const {
     throw std::invalid_argument("sensor parameter 'bins' is too large for the speckle table");
   if (encoder_size < azimuths)
     throw std::invalid_argument("sensor parameter 'encoder_size' must be at least 'azimuths'");
+  if (!reference_scene.empty()) {
+    try {
+      checkReferenceScene(reference_scene);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("sensor key 'reference_scene': ") + e.what());
+    }
+  }
 }
 
 void SensorConfig::curveWeights(double r, double w[4]) {
@@ -79,6 +87,8 @@ nlohmann::json SensorConfig::toJson() const {
   nlohmann::json j = nlohmann::json::object();
   visit([&](const ParamMeta& m, const auto& v) { j[m.name] = v; });
   if (!physics.empty()) j["physics"] = physics;
+  // Only when set, as "physics": a file without the key is written back without it.
+  if (!reference_scene.empty()) j["reference_scene"] = reference_scene;
   return j;
 }
 
@@ -88,6 +98,17 @@ SensorConfig SensorConfig::fromJson(const nlohmann::json& j) {
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (it.key() == "physics") {
       c.physics = sensorPhysicsFromJson(*it);
+      continue;
+    }
+    if (it.key() == "reference_scene") {
+      if (!it->is_string())
+        throw detail::JsonPathError({{"reference_scene", -1}}, "must be a built-in scene name (a string)");
+      c.reference_scene = it->get<std::string>();
+      try {
+        checkReferenceScene(c.reference_scene);
+      } catch (const std::invalid_argument& e) {
+        throw detail::JsonPathError({{"reference_scene", -1}}, e.what());
+      }
       continue;
     }
     bool found = false;

@@ -267,7 +267,9 @@ SPINRADAR_COMMAND(
                      "Reference scene of the appearance re-simulation: a built-in scene name, or "
                      "'recording' (the recording's own fit-part returns as scatterers; issue 20), "
                      "or 'combined' (gain chain and beam from the city scene's fit, the rest "
-                     "against the recording's own scene; docs/diagnose_scene.md)");
+                     "against the recording's own scene; docs/diagnose_scene.md). Default: the "
+                     "--sensor file's reference_scene, else city. A built-in scene is written "
+                     "into sensor_fitted.json as its reference_scene");
       app.add_option("--appearance-scene-margin", a->scene_margin_db,
                      "With the recording's own scene: a return stands this far (dB) over its "
                      "range bin's upper quartile")

@@ -9,6 +9,7 @@
 
 #include "diagnose_args.hpp"
 #include "spinradar/diagnose/appearance_split.hpp"
+#include "spinradar/sim/reference_scene.hpp"
 
 namespace spinradar::tools {
 
@@ -55,7 +56,9 @@ void runAppearance(const DiagnoseArgs& a, const std::vector<PolarScan>& scans,
   opt.fit_band_floor = a.fit_floor;
   opt.fit_band_zeros = a.fit_zeros;
   opt.fit_cen2018 = !a.no_cen2018_fit;
-  opt.scene = a.appearance_scene;
+  // A calibrated file is re-fitted and scored in the scene it was calibrated in unless
+  // --appearance-scene names another (its figures mean nothing elsewhere).
+  opt.scene = sim::sceneOrReference(a.appearance_scene, s, "city");
   opt.scene_margin_db = a.scene_margin_db;
   opt.scene_clean = a.scene_clean;
   opt.scene_margin_bands_db = a.scene_margins;

@@ -9,13 +9,16 @@
 #include "spinradar/io/scan_folder.hpp"
 #include "spinradar/sim/realism.hpp"
 #include "spinradar/sim/realism_seeds.hpp"
+#include "spinradar/sim/reference_scene.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
 
 namespace {
 
 struct RealismCmdOptions : spinradar::cli::SceneComparisonOptions {
-  RealismCmdOptions() { scenes = {"city", "out_and_back", "tight_turns"}; }
+  // No default scene list here: without --scene, runRealism takes the sensor file's
+  // reference_scene, else kDefaultScenes (the list before the key existed).
+  static inline const std::vector<std::string> kDefaultScenes = {"city", "out_and_back", "tight_turns"};
   int scans = 8;
   uint64_t seed = 1;
   int render_seeds = 1;  // noise seeds per scene: seed, seed + 1, ... (figures: mean [range])
@@ -56,7 +59,12 @@ void runRealism(const RealismCmdOptions& o) {
                                "boreas_rt/test_frame.png or radiate_fog_6_0/Navtech_Polar/*.png)");
     real_cols = std::move(real);
   }
-  for (const auto& name : o.scenes) {
+  // A calibrated sensor is compared in the scene it was fitted in unless --scene names scenes.
+  std::vector<std::string> scenes = o.scenes;
+  if (scenes.empty())
+    scenes = sensor.reference_scene.empty() ? RealismCmdOptions::kDefaultScenes
+                                            : std::vector<std::string>{sensor.reference_scene};
+  for (const auto& name : scenes) {
     const Scene sc = builtinScene(name);
     auto render = [&](uint64_t seed) {
       Simulator sim(sc.world, sc.trajectory, sensor, physics, seed);
@@ -95,6 +103,9 @@ SPINRADAR_COMMAND("realism", "Compare simulated scans with the real samples (his
                   [](CLI::App& app) {
                     auto o = std::make_shared<RealismCmdOptions>();
                     spinradar::cli::addSceneComparisonOptions(app, *o);
+                    app.get_option("--scene")->description(
+                        "Built-in scenes to simulate (default: the --sensor file's "
+                        "reference_scene, else city out_and_back tight_turns)");
                     app.add_option("--scans", o->scans, "Scans per simulated scene")
                         ->capture_default_str()
                         ->check(spinradar::cli::atLeast(1));

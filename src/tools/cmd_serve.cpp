@@ -11,6 +11,7 @@
 #include "command.hpp"
 #include "spinradar/driver/navtech_server.hpp"
 #include "spinradar/sim/physics.hpp"
+#include "spinradar/sim/reference_scene.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/sim_radar_input.hpp"
 
@@ -31,7 +32,7 @@ spinradar::sim::PhysicsConfig loadPhysics(const std::string& arg) {
 }
 
 struct ServeOptions {
-  std::string scene = "city";
+  std::string scene;  // empty: the sensor file's reference_scene, else city
   int port = 6317;
   std::string bind = "127.0.0.1";
   double rate = 1.0;
@@ -49,7 +50,9 @@ void serve(const ServeOptions& o) {
   using namespace spinradar;
   const sim::SensorConfig sensor =
       o.sensor.empty() ? sim::SensorConfig{} : sim::SensorConfig::loadNamed(o.sensor);
-  auto sim = sim::makeBuiltinSimulator(o.scene, loadPhysics(o.physics), o.seed, 0.0, sensor);
+  // A calibrated sensor is served in the scene it was fitted in unless --scene names one.
+  const std::string scene = sim::sceneOrReference(o.scene, sensor, "city");
+  auto sim = sim::makeBuiltinSimulator(scene, loadPhysics(o.physics), o.seed, 0.0, sensor);
   navtech::ServerOptions so;
   so.bind = o.bind;
   so.port = o.port;
@@ -68,7 +71,7 @@ void serve(const ServeOptions& o) {
   if (so.time_order == navtech::TimeByteOrder::Auto) so.time_order = navtech::TimeByteOrder::Little;
   navtech::NavtechServer server(so, sim::simScanSource(sim, 0, o.loop));
   server.start();
-  std::cerr << "serve: scene '" << o.scene << "' (" << sim->scanCount() << " rotations) on "
+  std::cerr << "serve: scene '" << scene << "' (" << sim->scanCount() << " rotations) on "
             << o.bind << ":" << server.port() << " at " << o.rate << "x real time"
             << (o.sim_clock ? ", simulator clock" : ", wall clock") << ", up to " << o.max_clients
             << " client(s) at once; Ctrl-C to stop"
@@ -94,8 +97,7 @@ void serve(const ServeOptions& o) {
 SPINRADAR_COMMAND("serve", "Serve a simulated scene as a live Navtech radar (TCP protocol) on a loopback port",
                   [](CLI::App& app) {
                     auto o = std::make_shared<ServeOptions>();
-                    app.add_option("--scene", o->scene, "Built-in scene: city, city_elevated, city_facades, city_facades_heights, city_heights, city_open, out_and_back or tight_turns")
-                        ->capture_default_str();
+                    app.add_option("--scene", o->scene, "Built-in scene: city, city_elevated, city_facades, city_facades_heights, city_heights, city_open, out_and_back or tight_turns (default: the --sensor file's reference_scene, else city)");
                     app.add_option("--port", o->port, "TCP port (Navtech default 6317; 0 = any free port)")
                         ->capture_default_str()
                         ->check(spinradar::cli::inRange(0, 65535));

@@ -9,6 +9,7 @@
 #include "cli_checks.hpp"
 #include "command.hpp"
 #include "spinradar/core/safe_output.hpp"
+#include "spinradar/sim/reference_scene.hpp"
 #include "spinradar/sim/scenes.hpp"
 #include "spinradar/sim/simulator.hpp"
 #ifdef SPINRADAR_HAVE_BAG
@@ -50,22 +51,28 @@ void runSimulate(const SimulateOptions& o) {
   // The recording is written aside and moved into place when complete (--force: over the old
   // scans of a non-empty folder).
   spinradar::AtomicOutputFolder out_dir(o.out, o.force);
+  SensorConfig sensor = o.sensor.empty() ? SensorConfig{} : SensorConfig::loadNamed(o.sensor);
+  // Without --scene, --world or --trajectory a calibrated sensor renders in its reference scene
+  // (the scene it was fitted in); with --world it renders there, as before.
+  const bool own_world = !o.world.empty() || !o.trajectory.empty();
+  const std::string scene = own_world ? o.scene : sceneOrReference(o.scene, sensor, "");
   World world;
   Trajectory traj;
-  if (!o.scene.empty()) {
-    if (!o.world.empty() || !o.trajectory.empty())
+  if (!scene.empty()) {
+    if (own_world)
       throw std::runtime_error("give either --scene or --world and --trajectory, not both");
-    Scene s = builtinScene(o.scene, o.variant, o.t0);
+    if (o.scene.empty()) std::cerr << "simulate: scene '" << scene << "' (the sensor file's reference_scene)\n";
+    Scene s = builtinScene(scene, o.variant, o.t0);
     world = std::move(s.world);
     traj = std::move(s.trajectory);
   } else {
     if (o.world.empty() || o.trajectory.empty())
-      throw std::runtime_error("give --scene NAME, or both --world JSON and --trajectory CSV");
+      throw std::runtime_error("give --scene NAME (or a --sensor file with a reference_scene), or "
+                               "both --world JSON and --trajectory CSV");
     world = World::load(o.world);
     traj = Trajectory::loadCsv(o.trajectory);
   }
   PhysicsConfig physics = o.physics.empty() ? PhysicsConfig{} : PhysicsConfig::load(o.physics);
-  SensorConfig sensor = o.sensor.empty() ? SensorConfig{} : SensorConfig::loadNamed(o.sensor);
   Simulator sim(std::move(world), std::move(traj), sensor, physics, o.seed);
   int total = sim.scanCount();
   std::cerr << "simulate: " << total << " rotations available, physics "
@@ -103,7 +110,7 @@ SPINRADAR_COMMAND("simulate", "Simulate a recording (Oxford polar PNGs + true tr
                   [](CLI::App& app) {
                     auto o = std::make_shared<SimulateOptions>();
                     app.add_option("--scene", o->scene,
-                                   "Built-in scene: city, city_elevated, city_facades, city_facades_heights, city_heights, city_open, out_and_back, tight_turns");
+                                   "Built-in scene: city, city_elevated, city_facades, city_facades_heights, city_heights, city_open, out_and_back, tight_turns (default: the --sensor file's reference_scene, if it has one)");
                     app.add_option("--world", o->world, "World JSON file");
                     app.add_option("--trajectory", o->trajectory, "Trajectory CSV (t,x,y,yaw)");
                     app.add_option("--physics", o->physics,

@@ -30,7 +30,7 @@ struct DiagnoseArgs {
   bool fit_floor = false;
   bool fit_zeros = false;
   bool no_cen2018_fit = false;
-  std::string appearance_scene = "city";
+  std::string appearance_scene;  // empty: the --sensor file's reference_scene, else city
   std::string gain_chain;  // scene "combined": held gain chain from this sensor (file or name)
   double scene_margin_db = 10.0;
   std::vector<double> scene_margins;  // per band: 2.5-10, 10-25, 25-50, 50 m and on

@@ -74,7 +74,13 @@ struct SensorConfig {
   /// unless its physics configuration sets the key. Empty (the default): no effect, and the
   /// sensor file has no "physics" entry.
   std::map<std::string, double> physics;
-  void validate() const;  ///< throws std::invalid_argument naming the parameter
+  /// The built-in scene this file was calibrated in (file key "reference_scene";
+  /// reference_scene.hpp): simulate, serve, realism and diagnose's appearance stage render the
+  /// sensor there when no scene is named. Written by diagnose into sensor_fitted.json from
+  /// --appearance-scene. Empty (the default): no key in the file, and those commands keep
+  /// their own default scene.
+  std::string reference_scene;
+  void validate() const;  ///< throws std::invalid_argument naming the parameter (or the scene)
   /// {"name": value, ...} for every parameter; fromJson takes a subset (unknown keys rejected).
   nlohmann::json toJson() const;
   static SensorConfig fromJson(const nlohmann::json& j);
