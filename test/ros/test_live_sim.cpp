@@ -147,7 +147,7 @@ TEST_F(LiveSim, TfAndCloudsAtTheScanRate) {
   const int64_t from = std::max({*std::min_element(g.tf_stamps.begin(), g.tf_stamps.end()),
                                  g.raw.begin()->first, g.corrected.begin()->first});
   size_t first = 0;
-  while (first < n && g.odom[first].header.stamp.toNSec() < from) ++first;
+  while (first < n && static_cast<int64_t>(g.odom[first].header.stamp.toNSec()) < from) ++first;
   ASSERT_LE(first, 4u) << "tf and clouds only from scan " << first;
   const size_t checked = n - first;
   // Every scan gives one odometry message, one tf and two clouds with the same stamp.

@@ -226,7 +226,9 @@ TEST(SimHeightRule, HeightScenesAreTheirFlatScenesWithHeights) {
     for (size_t i = 0; i < flat.world.targets.size(); ++i) {
       const Target &a = flat.world.targets[i], &b = tall.world.targets[i];
       ASSERT_TRUE(a.x == b.x && a.y == b.y && a.rcs == b.rcs && a.vx == b.vx && !b.elevated) << i;
-      if (i >= n_city) ASSERT_TRUE(b.height && *b.height > 0) << i;
+      if (i >= n_city) {
+        ASSERT_TRUE(b.height && *b.height > 0) << i;
+      }
     }
   }
 }

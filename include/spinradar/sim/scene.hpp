@@ -23,7 +23,7 @@ struct Target {
   /// seen over a wall crossing the line of sight at distance d < r iff
   /// (height - mount_height) * d > (wall height - mount_height) * r); a wall without a height
   /// is infinitely tall and hides it as before. "elevated" wins over it.
-  std::optional<double> height;
+  std::optional<double> height{};
 };
 
 struct Wall {
@@ -32,7 +32,7 @@ struct Wall {
   /// Top of the wall above the ground, m (JSON key "height", optional, 0..1000). Unset =
   /// infinitely tall: it hides everything behind it (the 2-D depth map, as before). A wall lower
   /// than the sensor (a parked car) hides only what lies below the line from the sensor over it.
-  std::optional<double> height;
+  std::optional<double> height{};
 };
 
 /// {"targets": [{"x","y","rcs"[,"vx","vy","elevated","height"]}],
