@@ -72,6 +72,14 @@ AppearanceFinding fitTextureLength(const std::vector<PolarScan>& real, sim::Sens
                                    const sim::PhysicsConfig& phys, const AppearanceOptions& opt,
                                    std::vector<std::string>& notes);
 
+/// Near-range leakage (appearance_leakage.cpp): fits leakage_db (and shortens leakage_range
+/// so the leak is down to the noise by 2.5 m) to the real near excess; when named, sets it in
+/// `cur` and re-renders `fig_cur`.
+AppearanceFinding fitLeakage(const AppearanceFigures& real, const sim::SensorConfig& sensor,
+                             sim::SensorConfig& cur, const sim::PhysicsConfig& phys,
+                             const AppearanceOptions& opt, AppearanceFigures& fig_cur,
+                             std::vector<std::string>& notes);
+
 /// Code set of the counts (appearance_texture.cpp): a recording with every code among 1-30
 /// against a model with the native Navtech set is a rescaled product: native_codes = 0 in `cur`
 /// and power_scale started from the spread of the noise side (refined with the range curves).

@@ -11,20 +11,16 @@
 #include <nlohmann/json.hpp>
 
 #include "file_errors.hpp"
+#include "render_geometry.hpp"
 #include "spinradar/io/poses_io.hpp"
 
 namespace spinradar::sim {
 
 using detail::JsonPathError;
 using detail::JsonStep;
+using detail::wrapPi;
 
 namespace {
-
-double wrapPi(double a) {
-  a = std::fmod(a + M_PI, 2 * M_PI);
-  if (a < 0) a += 2 * M_PI;
-  return a - M_PI;
-}
 
 double number(const nlohmann::json& obj, const std::vector<JsonStep>& at, const char* key,
               bool required, double def, double lo = -1e9, double hi = 1e9) {
