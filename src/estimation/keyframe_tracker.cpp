@@ -351,8 +351,8 @@ void KeyframeTracker::track(const FeatureFrame& cur, const Eigen::Matrix3d& T_w_
   const double switch_angle = scan_turn > config_.keyframe_angle
                                   ? std::max(config_.keyframe_angle, config_.keyframe_angle_fast)
                                   : config_.keyframe_angle;
-  const bool renew = (!still && !registered) || weak || dist > kKeyframeDistance || ang > switch_angle ||
-                     (registered && last_inliers_ < kInlierRatio * key_inliers_);
+  const bool renew = (!still && !registered) || weak || dist > config_.keyframe_distance || ang > switch_angle ||
+                     (registered && last_inliers_ < config_.keyframe_inlier_ratio * key_inliers_);
   prev_c_ = c;
   prev_pair_xi_ = pair.velocity;
   prev_xi_ = xi_k;

@@ -70,7 +70,7 @@ TEST(KeyframeTurnExit, RampKeyframeDoesNotPassAVelocityErrorOn) {
   // straight after it, truth and pair 0). Emulated with the tracker fed exact pairs (the
   // scene's velocity constant within each scan) except the first scan's velocity, e = 0.15
   // rad/s off: the first keyframe's map. 16 m/s, keyframes every third scan
-  // (kKeyframeDistance); scan 9, a keyframe, is a ramp (0 -> 0.2 rad/s -> 0). The scans
+  // (keyframe_distance); scan 9, a keyframe, is a ramp (0 -> 0.2 rad/s -> 0). The scans
   // registered to it are as far from the pair as it was, no change of the yaw rate, so from
   // there on the pair velocity moves them and the keyframes after it: the registered yaw
   // rate is back to the truth and the heading error stops growing (what the chain had

@@ -8,7 +8,6 @@
 namespace spinradar {
 
 struct KeyframeTuning {
-  static constexpr double kKeyframeDistance = 10.0;  ///< m, new keyframe beyond this
   static constexpr int kMinInliers = 30;
   /// A scan whose descriptors found kMinWeakInliers..kMinInliers-1 inliers where the
   /// proximity fallback does not run is registered with them and becomes the keyframe
@@ -39,7 +38,6 @@ struct KeyframeTuning {
   /// must also be EstimatorConfig::yaw_rate_sigmas standard deviations (keyframe_tracker.cpp).
   static constexpr double kRegisteredYawRateGap = 0.05;
   static constexpr double kRampYawAccel = 0.1;
-  static constexpr double kInlierRatio = 0.5;  ///< new keyframe below this x first count
   static constexpr double kPredictionGate = 2.0;  ///< m, first gate around the prediction
   // Prior inflation, chosen on the city route (README): velocity prior by acceleration over
   // kPriorLag scan periods; pose prior (pair step) by white-noise acceleration over a step.
