@@ -70,13 +70,16 @@ declare -A row_args=(
   # The default since the twentieth round: the nineteenth's plus the turn-heading blend
   # (docs/sensor_columns/round20_start_rate_default.md).
   [keyframe+peaks+graph+step+submap2+mapcheck+start0.25]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 2 --yaw_rate_map_check true --start_rate_pair_weight 0.25"
+  # The default with keyframes 7 m apart instead of 10 (docs/sensor_columns/round21_keyframe_spacing.md):
+  # better on the calibrated real-sensor models, worse on the simulator's own.
+  [default+distance7]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 2 --yaw_rate_map_check true --start_rate_pair_weight 0.25 --keyframe_distance 7"
   # The turn-heading option (docs/sensor_columns/round16_turn_heading.md) on the sixteenth round's default row.
   [default+start_rate0.25]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 1 --yaw_rate_map_check false --start_rate_pair_weight 0.25"
   [surface]="--estimator surface --azimuth_peaks false --keyframe_graph 0"
   [surface+peaks]="--estimator surface --azimuth_peaks true --keyframe_graph 0"
 )
 default_row="keyframe+peaks+graph+step+submap2+mapcheck+start0.25"  # the row the CLI's defaults give (issue 19)
-all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks keyframe+peaks+graph keyframe+peaks+graph+step keyframe+peaks+graph+step+submap2 keyframe+peaks+graph+step+submap2+mapcheck keyframe+peaks+graph+step+submap2+mapcheck+start0.25 default+start_rate0.25 surface surface+peaks)
+all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks keyframe+peaks+graph keyframe+peaks+graph+step keyframe+peaks+graph+step+submap2 keyframe+peaks+graph+step+submap2+mapcheck keyframe+peaks+graph+step+submap2+mapcheck+start0.25 default+distance7 default+start_rate0.25 surface surface+peaks)
 # Rows whose estimator this CLI does not know are left out (older builds).
 rows=()
 # Read once: `grep -q` closing the pipe early made `params` die of SIGPIPE, and with pipefail a
