@@ -6,13 +6,13 @@
 # Needs the built CLI (scripts/cli_path.sh); about 20 minutes on one core with one start of the range curves (several times that with the default 3, --appearance-curve-starts), most of it Boreas-RT
 # (6848 bins). Each sample's report: OUT/<sample>/appearance/appearance.md.
 # Env: APPEARANCE_SCENE (the reference world of every sample's fit, in place of its own: Oxford
-# city_heights, the city with building, car and tree heights, docs/diagnose_height_visibility.md;
-# the others city; city_facades: the city with the far structure of real streets,
-# docs/city_scene_far_structure.md). diagnose writes the scene into each file as its
-# "reference_scene" key, which simulate / serve / realism / the evaluation matrix then render
-# the file in; APPEARANCE_HOLD
-# (clutter: hold the clutter field at the start model's, i.e. off from the defaults, and fit the
-# sensor terms only; docs/diagnose_hold_clutter.md); RENDER_SEEDS (noise seeds of the before /
+# and MulRan city_heights, the city with building, car and tree heights,
+# docs/diagnose_height_visibility.md, docs/mulran_heights_refit.md; Boreas-RT and RADIATE city;
+# city_facades: the city with the far structure of real streets, docs/city_scene_far_structure.md).
+# diagnose writes the scene into each file as its "reference_scene" key, which simulate /
+# serve / realism / the evaluation matrix then render the file in; APPEARANCE_HOLD (clutter:
+# hold the clutter field at the start model's, i.e. off from the defaults, and fit the sensor
+# terms only; docs/diagnose_hold_clutter.md); RENDER_SEEDS (noise seeds of the before /
 # after figures, --render-seeds: means with their range) and FIT_SEEDS (noise seeds of the
 # range-curve fit's objective, --appearance-fit-seeds; docs/diagnose_render_seeds.md).
 set -euo pipefail
@@ -40,7 +40,12 @@ run() {  # name, scene, diagnose arguments...
 # RENDER_SEEDS=8 as H3 was run).
 run oxford city_heights --recording "$data/oxford_2019-01-10-14-36-48/radar" \
   ${OXFORD_START:+--sensor "$OXFORD_START" --appearance-iterations 0 --appearance-curve-starts 1 --appearance-fit-far-slope}
-run mulran city --recording "$data/mulran" --format mulran --range-resolution 0.0595238
+# MulRan's shipped file (docs/mulran_heights_refit.md, R2): the file before it refitted in
+# city_heights, far slope released, up to 40 steps of the range curves, 4 fit seeds. MULRAN_START
+# (git show d5b5928:config/sensors/mulran.json) reproduces it from that file (with FIT_SEEDS=4,
+# RENDER_SEEDS=8 as R2 was run); without it the fit starts from the defaults.
+run mulran city_heights --recording "$data/mulran" --format mulran --range-resolution 0.0595238 \
+  ${MULRAN_START:+--sensor "$MULRAN_START" --appearance-iterations 0 --appearance-curve-starts 1 --appearance-fit-far-slope --appearance-curve-iterations 40}
 run boreas_rt city --recording "$data/boreas_rt" --format boreas --range-resolution 0.04381
 run radiate city --recording "$data/radiate_fog_6_0/Navtech_Polar" --format auto --range-resolution 0.17361
 python3 "$root/scripts/appearance_table.py" "$out"

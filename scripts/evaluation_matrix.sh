@@ -30,7 +30,7 @@
 #      CITY_SCENE (the built-in scene of every city_* column, default city; city_facades adds
 #      the far structure of real streets, docs/city_scene_far_structure.md), except the
 #      calibrated columns (city_<sensor>, city_oxford_glint0.14) of a file with a
-#      "reference_scene" key, which render in that scene (Oxford: city_heights).
+#      "reference_scene" key, which render in that scene (Oxford, MulRan: city_heights).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="${1:-$root/build/evaluation_matrix}"

@@ -98,11 +98,13 @@ TEST(SimReferenceScene, BadValuesRefused) {
   std::remove(path.c_str());
 }
 
-// The shipped files: Oxford was calibrated in city_heights (docs/diagnose_height_visibility.md,
-// H3); the other three have no key (they behave as before this key existed).
+// The shipped files: Oxford (docs/diagnose_height_visibility.md, H3) and MulRan
+// (docs/mulran_heights_refit.md) were calibrated in city_heights; the other two have no key
+// (they behave as before this key existed).
 TEST(SimReferenceScene, ShippedFiles) {
   const std::string dir = std::string(SPINRADAR_SOURCE_DIR) + "/config/sensors/";
-  EXPECT_EQ(SensorConfig::load(dir + "oxford.json").reference_scene, "city_heights");
-  for (const char* n : {"mulran", "boreas_rt", "radiate"})
+  for (const char* n : {"oxford", "mulran"})
+    EXPECT_EQ(SensorConfig::load(dir + n + ".json").reference_scene, "city_heights") << n;
+  for (const char* n : {"boreas_rt", "radiate"})
     EXPECT_EQ(SensorConfig::load(dir + n + ".json").reference_scene, "") << n;
 }
