@@ -99,12 +99,11 @@ TEST(SimReferenceScene, BadValuesRefused) {
 }
 
 // The shipped files: Oxford (docs/diagnose_height_visibility.md, H3) and MulRan
-// (docs/mulran_heights_refit.md) were calibrated in city_heights; the other two have no key
-// (they behave as before this key existed).
+// (docs/mulran_heights_refit.md) were calibrated in city_heights, Boreas-RT and RADIATE in city.
 TEST(SimReferenceScene, ShippedFiles) {
   const std::string dir = std::string(SPINRADAR_SOURCE_DIR) + "/config/sensors/";
   for (const char* n : {"oxford", "mulran"})
     EXPECT_EQ(SensorConfig::load(dir + n + ".json").reference_scene, "city_heights") << n;
   for (const char* n : {"boreas_rt", "radiate"})
-    EXPECT_EQ(SensorConfig::load(dir + n + ".json").reference_scene, "") << n;
+    EXPECT_EQ(SensorConfig::load(dir + n + ".json").reference_scene, "city") << n;
 }
