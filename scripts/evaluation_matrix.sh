@@ -51,35 +51,40 @@ mkdir -p "$out"
 # Every row names its front end: azimuth_peaks is on by default since 2026-11-27, and the rows
 # without "+peaks" are the paper's front end (one keypoint per row at the row angle). Every row
 # pins keyframe_graph, so a row means the same whatever the default ("+graph": window 6,
-# "+step": with keyframe_graph_step).
+# "+step": with keyframe_graph_step), and every keyframe row pins keyframe_distance (10 m unless
+# the label says otherwise: the default before the twenty-second round).
 declare -A row_args=(
   [rigid]="--estimator rigid --azimuth_peaks false"
   [mc]="--estimator mc --azimuth_peaks false"
   [mc_doppler]="--estimator mc_doppler --azimuth_peaks false"
   [refined]="--estimator refined --azimuth_peaks false"
-  [keyframe]="--estimator keyframe --azimuth_peaks false --keyframe_graph 0 --submap_keyframes 1 --yaw_rate_map_check false --start_rate_pair_weight 0"
-  [keyframe+peaks]="--estimator keyframe --azimuth_peaks true --keyframe_graph 0 --submap_keyframes 1 --yaw_rate_map_check false --start_rate_pair_weight 0"
-  [keyframe+peaks+graph]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step false --submap_keyframes 1 --yaw_rate_map_check false --start_rate_pair_weight 0"
-  [keyframe+peaks+graph+step]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 1 --yaw_rate_map_check false --start_rate_pair_weight 0"
+  [keyframe]="--estimator keyframe --azimuth_peaks false --keyframe_graph 0 --submap_keyframes 1 --yaw_rate_map_check false --start_rate_pair_weight 0 --keyframe_distance 10"
+  [keyframe+peaks]="--estimator keyframe --azimuth_peaks true --keyframe_graph 0 --submap_keyframes 1 --yaw_rate_map_check false --start_rate_pair_weight 0 --keyframe_distance 10"
+  [keyframe+peaks+graph]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step false --submap_keyframes 1 --yaw_rate_map_check false --start_rate_pair_weight 0 --keyframe_distance 10"
+  [keyframe+peaks+graph+step]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 1 --yaw_rate_map_check false --start_rate_pair_weight 0 --keyframe_distance 10"
   # The eighteenth round's candidate: the map averaged with the previous keyframe's where the
   # two agree (docs/sensor_columns/round18_submap_agreement.md).
-  [keyframe+peaks+graph+step+submap2]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 2 --yaw_rate_map_check false --start_rate_pair_weight 0"
+  [keyframe+peaks+graph+step+submap2]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 2 --yaw_rate_map_check false --start_rate_pair_weight 0 --keyframe_distance 10"
   # The nineteenth round's default: with it a registration's repeated yaw-rate difference is
   # the map's error (docs/sensor_columns/round19_map_rate_bias.md).
-  [keyframe+peaks+graph+step+submap2+mapcheck]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 2 --yaw_rate_map_check true --start_rate_pair_weight 0"
+  [keyframe+peaks+graph+step+submap2+mapcheck]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 2 --yaw_rate_map_check true --start_rate_pair_weight 0 --keyframe_distance 10"
   # The default since the twentieth round: the nineteenth's plus the turn-heading blend
   # (docs/sensor_columns/round20_start_rate_default.md).
-  [keyframe+peaks+graph+step+submap2+mapcheck+start0.25]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 2 --yaw_rate_map_check true --start_rate_pair_weight 0.25"
-  # The default with keyframes 7 m apart instead of 10 (docs/sensor_columns/round21_keyframe_spacing.md):
-  # better on the calibrated real-sensor models, worse on the simulator's own.
+  [keyframe+peaks+graph+step+submap2+mapcheck+start0.25]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 2 --yaw_rate_map_check true --start_rate_pair_weight 0.25 --keyframe_distance 10"
+  # The default since the twenty-second round: keyframes 9 m apart instead of 10
+  # (docs/sensor_columns/round22_keyframe_spacing_phases.md).
+  [keyframe+peaks+graph+step+submap2+mapcheck+start0.25+distance9]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 2 --yaw_rate_map_check true --start_rate_pair_weight 0.25 --keyframe_distance 9"
+  # The twentieth round's default with keyframes 7 m apart instead of 10
+  # (docs/sensor_columns/round21_keyframe_spacing.md): better on the calibrated real-sensor
+  # models, worse on the simulator's own.
   [default+distance7]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 2 --yaw_rate_map_check true --start_rate_pair_weight 0.25 --keyframe_distance 7"
   # The turn-heading option (docs/sensor_columns/round16_turn_heading.md) on the sixteenth round's default row.
-  [default+start_rate0.25]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 1 --yaw_rate_map_check false --start_rate_pair_weight 0.25"
+  [default+start_rate0.25]="--estimator keyframe --azimuth_peaks true --keyframe_graph 6 --keyframe_graph_step true --submap_keyframes 1 --yaw_rate_map_check false --start_rate_pair_weight 0.25 --keyframe_distance 10"
   [surface]="--estimator surface --azimuth_peaks false --keyframe_graph 0"
   [surface+peaks]="--estimator surface --azimuth_peaks true --keyframe_graph 0"
 )
-default_row="keyframe+peaks+graph+step+submap2+mapcheck+start0.25"  # the row the CLI's defaults give (issue 19)
-all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks keyframe+peaks+graph keyframe+peaks+graph+step keyframe+peaks+graph+step+submap2 keyframe+peaks+graph+step+submap2+mapcheck keyframe+peaks+graph+step+submap2+mapcheck+start0.25 default+distance7 default+start_rate0.25 surface surface+peaks)
+default_row="keyframe+peaks+graph+step+submap2+mapcheck+start0.25+distance9"  # the row the CLI's defaults give (issue 19)
+all_rows=(rigid mc mc_doppler refined keyframe keyframe+peaks keyframe+peaks+graph keyframe+peaks+graph+step keyframe+peaks+graph+step+submap2 keyframe+peaks+graph+step+submap2+mapcheck keyframe+peaks+graph+step+submap2+mapcheck+start0.25 keyframe+peaks+graph+step+submap2+mapcheck+start0.25+distance9 default+distance7 default+start_rate0.25 surface surface+peaks)
 # Rows whose estimator this CLI does not know are left out (older builds).
 rows=()
 # Read once: `grep -q` closing the pipe early made `params` die of SIGPIPE, and with pipefail a
