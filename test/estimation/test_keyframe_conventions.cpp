@@ -14,6 +14,7 @@
 #include <cmath>
 #include <iostream>
 
+#include "support/laid_out_keyframes.hpp"
 #include "support/synthetic_scene.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/estimation/keyframe_tracker.hpp"
@@ -43,9 +44,8 @@ Errors trackWithTruePrior(SyntheticScene& scene, int scans) {
   // twentieth round): it mixes this harness's noisy pair step into the scans after turn
   // switches in every arm alike; its own test is KeyframeStartRate.
   cfg.start_rate_pair_weight = 0.0;
-  // Keyframes 10 m apart, as these drives were laid out (the default is 9 m since the
-  // twenty-second round): the other spacing moves which scans register against which keyframe.
-  cfg.keyframe_distance = 10.0;
+  // As these drives were laid out (support/laid_out_keyframes.hpp).
+  cfg.keyframe_distance = spinradar::testing::kLaidOutKeyframeDistance;
   KeyframeTracker kt(cfg);
   Errors e;
   Eigen::Matrix3d T_w = Eigen::Matrix3d::Identity(), P = Eigen::Matrix3d::Zero();

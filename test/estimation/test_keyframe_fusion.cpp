@@ -11,6 +11,7 @@
 #include <cmath>
 #include <iostream>
 
+#include "support/laid_out_keyframes.hpp"
 #include "support/glint_drive.hpp"
 
 using namespace spinradar;
@@ -27,8 +28,8 @@ Drive drive(uint32_t seed, double glint, int fusion) {
   // keyframe_fusion acts only without the pose graph (keyframe_tracker.cpp: the graph takes
   // the switch when keyframe_graph > 0, the default since 2026-11-27): pinned off here.
   cfg.keyframe_graph = 0;
-  // Measured with keyframes 10 m apart (the default before the twenty-second round, 9 m now).
-  cfg.keyframe_distance = 10.0;
+  // As the drive was laid out (support/laid_out_keyframes.hpp).
+  cfg.keyframe_distance = spinradar::testing::kLaidOutKeyframeDistance;
   return spinradar::testing::glintDrive(seed, glint, cfg);
 }
 

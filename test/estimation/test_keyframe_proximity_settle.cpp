@@ -17,6 +17,7 @@
 #include <random>
 #include <vector>
 
+#include "support/laid_out_keyframes.hpp"
 #include "support/noisy_prior.hpp"
 #include "support/synthetic_scene.hpp"
 #include "spinradar/core/lie.hpp"
@@ -52,9 +53,8 @@ double drive(uint32_t seed, double settle_gate) {
   EstimatorConfig cfg;
   cfg.beta = 0.0;
   cfg.proximity_settle_gate = settle_gate;
-  // Keyframes 10 m apart, as this drive was laid out and measured (the default is 9 m since the
-  // twenty-second round, docs/sensor_columns/round22_keyframe_spacing_phases.md).
-  cfg.keyframe_distance = 10.0;
+  // As this drive was laid out (support/laid_out_keyframes.hpp).
+  cfg.keyframe_distance = spinradar::testing::kLaidOutKeyframeDistance;
   // The chain without the pose graph (default keyframe_graph 6 since 2026-11-27): the graph
   // averages the same heading walk over the window, both ways (measured with it: 4.23 -> 3.03
   // deg summed, lower on 4 of 6 seeds), and this checks the settling on its own.

@@ -18,6 +18,7 @@
 #include <iostream>
 #include <random>
 
+#include "support/laid_out_keyframes.hpp"
 #include "support/synthetic_scene.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/estimation/keyframe_tracker.hpp"
@@ -55,9 +56,8 @@ Result drive(uint32_t seed, double yaw_rate_sigmas, double tangential, double az
   EstimatorConfig cfg;
   cfg.beta = 0.0;
   cfg.yaw_rate_sigmas = yaw_rate_sigmas;
-  // Keyframes 10 m apart, as this drive was laid out and measured (the default is 9 m since the
-  // twenty-second round, docs/sensor_columns/round22_keyframe_spacing_phases.md).
-  cfg.keyframe_distance = 10.0;
+  // As this drive was laid out (support/laid_out_keyframes.hpp).
+  cfg.keyframe_distance = spinradar::testing::kLaidOutKeyframeDistance;
   // Measured without the turn-heading blend (start_rate_pair_weight, default 0.25 since the
   // twentieth round): it mixes this harness's noisy pair step into the scans after turn
   // switches in every arm alike; its own test is KeyframeStartRate.

@@ -17,6 +17,7 @@
 #include <iostream>
 #include <vector>
 
+#include "support/laid_out_keyframes.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/estimation/odometry.hpp"
 #include "spinradar/sim/scenes.hpp"
@@ -42,9 +43,8 @@ LagError run(const sim::Simulator& s, const sim::Trajectory& traj, int graph, bo
              int submap) {
   PipelineConfig cfg;
   cfg.estimator.keyframe_graph = graph;
-  // Keyframes 10 m apart, as this drive was laid out and measured (the default is 9 m since the
-  // twenty-second round, docs/sensor_columns/round22_keyframe_spacing_phases.md).
-  cfg.estimator.keyframe_distance = 10.0;
+  // As this drive was laid out (support/laid_out_keyframes.hpp).
+  cfg.estimator.keyframe_distance = spinradar::testing::kLaidOutKeyframeDistance;
   cfg.estimator.keyframe_graph_step = step;
   cfg.estimator.submap_keyframes = submap;
   Odometry odo(cfg);

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <iostream>
 
+#include "support/laid_out_keyframes.hpp"
 #include "spinradar/core/lie.hpp"
 #include "spinradar/estimation/odometry.hpp"
 #include "spinradar/sim/scenes.hpp"
@@ -36,9 +37,8 @@ struct TurnEntry {
 TurnEntry run(const sim::Simulator& s, const sim::Trajectory& traj, int k0, int k1, double t0,
               double t1, int graph, bool rate, PipelineConfig cfg) {
   cfg.estimator.keyframe_graph = graph;
-  // Keyframes 10 m apart, as this drive was laid out and measured (the default is 9 m since the
-  // twenty-second round, docs/sensor_columns/round22_keyframe_spacing_phases.md).
-  cfg.estimator.keyframe_distance = 10.0;
+  // As this drive was laid out (support/laid_out_keyframes.hpp).
+  cfg.estimator.keyframe_distance = spinradar::testing::kLaidOutKeyframeDistance;
   cfg.estimator.keyframe_graph_rate = rate;
   Odometry odo(cfg);
   Eigen::Matrix3d T0 = Eigen::Matrix3d::Identity();
