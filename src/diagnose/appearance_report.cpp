@@ -272,27 +272,27 @@ void writeAppearanceReport(const AppearanceReport& rep, const std::vector<PolarS
   const auto before = renderReference(rep.base, rep.base_physics, opt, opt.seed + 1);
   const auto after = renderReference(rep.fitted, rep.fitted_physics, opt, opt.seed + 1);
   using plot::Plot;
+  // Each panel: one figure for the recording, the base model and the fitted model.
+  const auto panel = [](const char* title, const char* xlabel, const char* ylabel,
+                        const std::vector<double>& x, const std::vector<double>& rec,
+                        const std::vector<double>& base, const std::vector<double>& fitted) {
+    return Plot()
+        .title(title)
+        .xlabel(xlabel)
+        .ylabel(ylabel)
+        .line(x, rec, "recording")
+        .line(x, base, "sim, base model")
+        .line(x, fitted, "sim, fitted model")
+        .render(700, 450);
+  };
   std::vector<cv::Mat> panels;
   std::vector<double> x;
   auto pr = rangeProfile(real, x), pb = rangeProfile(before, x), pa = rangeProfile(after, x);
-  panels.push_back(Plot()
-                       .title("mean count vs range")
-                       .xlabel("range (m)")
-                       .ylabel("mean count (~dB)")
-                       .line(x, pr, "recording")
-                       .line(x, pb, "sim, base model")
-                       .line(x, pa, "sim, fitted model")
-                       .render(700, 450));
+  panels.push_back(panel("mean count vs range", "range (m)", "mean count (~dB)", x, pr, pb, pa));
   std::vector<double> cx(256);
   for (int v = 0; v < 256; ++v) cx[v] = v;
-  panels.push_back(Plot()
-                       .title("intensity histogram")
-                       .xlabel("count")
-                       .ylabel("log10 share of cells")
-                       .line(cx, logHistogram(real), "recording")
-                       .line(cx, logHistogram(before), "sim, base model")
-                       .line(cx, logHistogram(after), "sim, fitted model")
-                       .render(700, 450));
+  panels.push_back(panel("intensity histogram", "count", "log10 share of cells", cx,
+                         logHistogram(real), logHistogram(before), logHistogram(after)));
   std::vector<double> bx = {6.25, 17.5, 37.5, 75}, cr, cb, ca, fr, fb, fa;
   for (int k = 0; k < kBands; ++k) {
     cr.push_back(std::pow(10.0, rep.real.cfar[k]) - 1);
@@ -302,22 +302,10 @@ void writeAppearanceReport(const AppearanceReport& rep, const std::vector<PolarS
     fb.push_back(rep.before.bright[k]);
     fa.push_back(rep.after.bright[k]);
   }
-  panels.push_back(Plot()
-                       .title("plain CA-CFAR cells per scan, by range band")
-                       .xlabel("band centre (m)")
-                       .ylabel("cells per scan")
-                       .line(bx, cr, "recording")
-                       .line(bx, cb, "sim, base model")
-                       .line(bx, ca, "sim, fitted model")
-                       .render(700, 450));
-  panels.push_back(Plot()
-                       .title("brightest 5 % by range band (range gain)")
-                       .xlabel("band centre (m)")
-                       .ylabel("mean count")
-                       .line(bx, fr, "recording")
-                       .line(bx, fb, "sim, base model")
-                       .line(bx, fa, "sim, fitted model")
-                       .render(700, 450));
+  panels.push_back(panel("plain CA-CFAR cells per scan, by range band", "band centre (m)",
+                         "cells per scan", bx, cr, cb, ca));
+  panels.push_back(panel("brightest 5 % by range band (range gain)", "band centre (m)",
+                         "mean count", bx, fr, fb, fa));
   plot::saveImage(plot::tile(panels, 2), (d / "appearance.png").string());
 }
 

@@ -205,35 +205,28 @@ void writeReport(const DiagnoseReport& rep, const std::string& out_dir) {
     rng.push_back(o.range);
   }
   using plot::Plot;
+  // Each panel: one residual against one quantity, base model and fitted model.
+  const auto panel = [](const char* title, const char* xlabel, const char* ylabel,
+                        const std::vector<double>& x, const std::vector<double>& base,
+                        const std::vector<double>& fitted) {
+    return Plot()
+        .title(title)
+        .xlabel(xlabel)
+        .ylabel(ylabel)
+        .scatter(x, base, "base model")
+        .scatter(x, fitted, "fitted model")
+        .render(700, 450);
+  };
   std::vector<cv::Mat> panels;
-  panels.push_back(Plot()
-                       .title("range residual vs azimuth")
-                       .xlabel("azimuth (deg, clockwise)")
-                       .ylabel("real - sim range (cm)")
-                       .scatter(az, er, "base model")
-                       .scatter(az, er_f, "fitted model")
-                       .render(700, 450));
-  panels.push_back(Plot()
-                       .title("tangential residual vs azimuth")
-                       .xlabel("azimuth (deg, clockwise)")
-                       .ylabel("range x azimuth residual (cm)")
-                       .scatter(az, et, "base model")
-                       .scatter(az, et_f, "fitted model")
-                       .render(700, 450));
-  panels.push_back(Plot()
-                       .title("range residual vs radial velocity (Doppler signature)")
-                       .xlabel("sensor velocity along the ray (m/s)")
-                       .ylabel("real - sim range (cm)")
-                       .scatter(vr, er, "base model")
-                       .scatter(vr, er_f, "fitted model")
-                       .render(700, 450));
-  panels.push_back(Plot()
-                       .title("range residual vs range")
-                       .xlabel("range (m)")
-                       .ylabel("real - sim range (cm)")
-                       .scatter(rng, er, "base model")
-                       .scatter(rng, er_f, "fitted model")
-                       .render(700, 450));
+  panels.push_back(panel("range residual vs azimuth", "azimuth (deg, clockwise)",
+                         "real - sim range (cm)", az, er, er_f));
+  panels.push_back(panel("tangential residual vs azimuth", "azimuth (deg, clockwise)",
+                         "range x azimuth residual (cm)", az, et, et_f));
+  panels.push_back(panel("range residual vs radial velocity (Doppler signature)",
+                         "sensor velocity along the ray (m/s)", "real - sim range (cm)", vr, er,
+                         er_f));
+  panels.push_back(panel("range residual vs range", "range (m)", "real - sim range (cm)", rng, er,
+                         er_f));
   plot::saveImage(plot::tile(panels, 2), (fs::path(out_dir) / "residuals.png").string());
 
   // Per scan: mean and RMS of the residuals.
