@@ -36,10 +36,8 @@ Drive drive(uint32_t seed, double glint, int fusion) {
 }  // namespace
 
 TEST(KeyframeFusion, LowersTheChainsWalkWhereItDominatesAndLosesNothingElse) {
-  double sum = 0.0, sum_f = 0.0, sum_c = 0.0, sum_cf = 0.0, nees_f = 0.0, hnees_f = 0.0;
-  double nees = 0.0;
-  int lower = 0, seeds = 0, fused = 0;
-  for (uint32_t seed = 1; seed <= 5; ++seed, ++seeds) {
+  spinradar::testing::GlintTally t;
+  for (uint32_t seed = 1; seed <= 5; ++seed) {
     const Drive one = drive(seed, 0.14, 0), two = drive(seed, 0.14, 1);
     const Drive clean = drive(seed, 0.0, 0), clean_f = drive(seed, 0.0, 1);
     std::cout << "[ info ] seed " << seed << ", heading rms deg with 0.14 m glint: "
@@ -50,26 +48,16 @@ TEST(KeyframeFusion, LowersTheChainsWalkWhereItDominatesAndLosesNothingElse) {
               << ", heading " << one.heading_nees << " -> " << two.heading_nees << "\n";
     ASSERT_GE(one.switches, 10) << "seed " << seed;
     EXPECT_EQ(one.fused + one.refused, 0);  // off: no extra registration
-    lower += two.heading_rms < one.heading_rms;
-    sum += one.heading_rms;
-    sum_f += two.heading_rms;
-    sum_c += clean.heading_rms;
-    sum_cf += clean_f.heading_rms;
-    nees = std::max(nees, one.nees);
-    nees_f = std::max({nees_f, two.nees, clean_f.nees});
-    hnees_f = std::max({hnees_f, two.heading_nees, clean_f.heading_nees});
-    fused += two.fused;
+    t.add(one, two, clean, clean_f);
   }
-  std::cout << "[ info ] summed heading rms deg, glint: " << sum / kDeg << " -> " << sum_f / kDeg
-            << "; without: " << sum_c / kDeg << " -> " << sum_cf / kDeg
-            << "; largest NEES " << nees << " -> " << nees_f << ", heading " << hnees_f << "\n";
-  EXPECT_GT(fused, 5 * seeds);  // most switches fuse
+  t.print();
+  EXPECT_GT(t.fused, 5 * t.seeds);  // most switches fuse
   // Glint: the fusion lowers the heading walk on most seeds and clearly in sum.
-  EXPECT_GE(lower, seeds - 1);
-  EXPECT_LT(sum_f, 0.9 * sum);
+  EXPECT_GE(t.lower, t.seeds - 1);
+  EXPECT_LT(t.sum_f, 0.9 * t.sum);
   // Without glint no loss (within a tenth).
-  EXPECT_LT(sum_cf, 1.1 * sum_c + 0.005 * kDeg * seeds);
+  EXPECT_LT(t.sum_cf, 1.1 * t.sum_c + 0.005 * kDeg * t.seeds);
   // The published covariance stays honest: not over-confident (3 dof, and the heading's).
-  EXPECT_LT(nees_f, 3.0 * 1.5);
-  EXPECT_LT(hnees_f, 1.5);
+  EXPECT_LT(t.nees_f, 3.0 * 1.5);
+  EXPECT_LT(t.hnees_f, 1.5);
 }

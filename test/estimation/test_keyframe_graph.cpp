@@ -32,10 +32,8 @@ Drive drive(uint32_t seed, double glint, int graph) {
 constexpr int kWindow = 6;
 
 TEST(KeyframeGraph, AveragesTheHeadingWalkUnderGlintAndLosesNothingWithout) {
-  double sum = 0.0, sum_f = 0.0, sum_c = 0.0, sum_cf = 0.0, nees_f = 0.0, hnees_f = 0.0;
-  double nees = 0.0;
-  int lower = 0, lower_key = 0, seeds = 0, fused = 0;
-  for (uint32_t seed = 1; seed <= 5; ++seed, ++seeds) {
+  spinradar::testing::GlintTally t;
+  for (uint32_t seed = 1; seed <= 5; ++seed) {
     const Drive one = drive(seed, 0.14, 0), two = drive(seed, 0.14, kWindow);
     const Drive clean = drive(seed, 0.0, 0), clean_f = drive(seed, 0.0, kWindow);
     std::cout << "[ info ] seed " << seed << ", heading rms deg with 0.14 m glint: "
@@ -49,25 +47,14 @@ TEST(KeyframeGraph, AveragesTheHeadingWalkUnderGlintAndLosesNothingWithout) {
               << one.heading_nees << " -> " << two.heading_nees << "\n";
     ASSERT_GE(one.switches, 10) << "seed " << seed;
     EXPECT_EQ(one.fused + one.refused, 0);  // off: no extra registration
-    lower += two.heading_rms < one.heading_rms;
-    lower_key += two.key_heading_rms < one.key_heading_rms;
-    sum += one.heading_rms;
-    sum_f += two.heading_rms;
-    sum_c += clean.heading_rms;
-    sum_cf += clean_f.heading_rms;
-    nees = std::max(nees, one.nees);
-    nees_f = std::max({nees_f, two.nees, clean_f.nees});
-    hnees_f = std::max({hnees_f, two.heading_nees, clean_f.heading_nees});
-    fused += two.fused;
+    t.add(one, two, clean, clean_f);
   }
-  std::cout << "[ info ] summed heading rms deg, glint: " << sum / kDeg << " -> " << sum_f / kDeg
-            << "; without: " << sum_c / kDeg << " -> " << sum_cf / kDeg
-            << "; largest NEES " << nees << " -> " << nees_f << ", heading " << hnees_f << "\n";
-  EXPECT_GT(fused, 5 * seeds);
-  EXPECT_GE(lower, seeds - 1);
-  EXPECT_GE(lower_key, seeds - 1);  // and at the keyframes the later scans are chained from
-  EXPECT_LT(sum_f, 0.9 * sum);
-  EXPECT_LT(sum_cf, 1.1 * sum_c + 0.005 * kDeg * seeds);
-  EXPECT_LT(nees_f, 3.0 * 1.5);
-  EXPECT_LT(hnees_f, 1.5);
+  t.print();
+  EXPECT_GT(t.fused, 5 * t.seeds);
+  EXPECT_GE(t.lower, t.seeds - 1);
+  EXPECT_GE(t.lower_key, t.seeds - 1);  // and at the keyframes the later scans are chained from
+  EXPECT_LT(t.sum_f, 0.9 * t.sum);
+  EXPECT_LT(t.sum_cf, 1.1 * t.sum_c + 0.005 * kDeg * t.seeds);
+  EXPECT_LT(t.nees_f, 3.0 * 1.5);
+  EXPECT_LT(t.hnees_f, 1.5);
 }

@@ -2,8 +2,10 @@
 // figures the keyframe fusion and pose-graph tests compare with the option on and off.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iostream>
 
 #include <Eigen/Cholesky>
 
@@ -64,5 +66,34 @@ inline GlintDrive glintDrive(uint32_t seed, double glint, EstimatorConfig cfg, i
   run.refused = kt.fusionsRejected();
   return run;
 }
+
+/// The figures a test compares over seeds: drives with the option off (`one`, `clean`) and
+/// on (`two`, `clean_f`), with glint and without.
+struct GlintTally {
+  double sum = 0.0, sum_f = 0.0, sum_c = 0.0, sum_cf = 0.0;  ///< summed heading rms, rad
+  double nees = 0.0, nees_f = 0.0, hnees_f = 0.0;             ///< the largest NEES
+  int seeds = 0, lower = 0, lower_key = 0, fused = 0;
+
+  void add(const GlintDrive& one, const GlintDrive& two, const GlintDrive& clean,
+           const GlintDrive& clean_f) {
+    ++seeds;
+    lower += two.heading_rms < one.heading_rms;
+    lower_key += two.key_heading_rms < one.key_heading_rms;
+    sum += one.heading_rms;
+    sum_f += two.heading_rms;
+    sum_c += clean.heading_rms;
+    sum_cf += clean_f.heading_rms;
+    nees = std::max(nees, one.nees);
+    nees_f = std::max({nees_f, two.nees, clean_f.nees});
+    hnees_f = std::max({hnees_f, two.heading_nees, clean_f.heading_nees});
+    fused += two.fused;
+  }
+  void print() const {
+    const double deg = M_PI / 180.0;
+    std::cout << "[ info ] summed heading rms deg, glint: " << sum / deg << " -> " << sum_f / deg
+              << "; without: " << sum_c / deg << " -> " << sum_cf / deg << "; largest NEES "
+              << nees << " -> " << nees_f << ", heading " << hnees_f << "\n";
+  }
+};
 
 }  // namespace spinradar::testing
