@@ -92,6 +92,16 @@ if(EXISTS ${PROJECT_SOURCE_DIR}/src/tools/cmd_odometry.cpp)
   endif()
 endif()
 
+# diagnose guesses a recording's scan format as odometry does: the RADIATE sample (no row
+# stamps or encoder columns) is read without --format (it once defaulted to oxford and failed).
+if(TARGET spinradar_diagnose)
+  add_test(NAME cli_diagnose_radiate_sample_format
+    COMMAND bash ${_tt}/with_realdata.sh ${SPINRADAR_SHARED_DIR} ${_cli} diagnose --timing-only
+            --recording ${SPINRADAR_SHARED_DIR}/realdata/radiate_fog_6_0 --out ${_out}/diagnose_radiate)
+  set_tests_properties(cli_diagnose_radiate_sample_format PROPERTIES
+    PASS_REGULAR_EXPRESSION "report in [^\n]*diagnose_radiate" SKIP_RETURN_CODE 77)
+endif()
+
 # The evaluation matrix's list of the default's losses (per seed; bootstrap over real pairs)
 # against figures with a known answer (test/tools/matrix_table_losses.py).
 add_test(NAME cli_matrix_table_losses

@@ -195,7 +195,8 @@ SPINRADAR_COMMAND(
       app.add_option("--trajectory", a->trajectory,
                      "Sensor trajectory CSV t,x,y,yaw (without it only the timing stage runs)");
       app.add_option("--format", a->format,
-                     "Scan format of the recording: oxford (default), boreas, mulran, auto");
+                     "Scan format of the recording (default: guessed from the folder)")
+          ->check(CLI::IsMember({"auto", "oxford", "boreas", "mulran", "radiate"}));
       app.add_flag("--timing-only", a->timing_only,
                    "Only the timing stage (stamps: bursts, period per scan); no world or "
                    "trajectory needed");

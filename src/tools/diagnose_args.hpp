@@ -12,7 +12,7 @@
 namespace spinradar::tools {
 
 struct DiagnoseArgs {
-  std::string recording, trajectory, world, base, out, map_split = "auto", format = "oxford";
+  std::string recording, trajectory, world, base, out, map_split = "auto", format = "auto";
   bool timing_only = false;
   double range_resolution = 0;  // 0: sensor.json or the default
   int first_scan = 0, max_scans = -1;
