@@ -77,6 +77,9 @@ void decodeRows(const cv::Mat& img, const std::string& name, double resolution, 
     if (enc >= scan.encoder_size) {
       std::ostringstream s;
       s << name << ": row " << a << ": encoder " << enc << " >= " << scan.encoder_size;
+      // On the first row this is most often another layout read as Oxford / Boreas (a RADIATE
+      // image's first pixels are returns, not metadata).
+      if (a == 0) s << " (not an Oxford / Boreas row: another format? --format radiate or mulran)";
       throw std::runtime_error(s.str());
     }
     if (us > INT64_MAX / 1000 || us < INT64_MIN / 1000) {  // ns would overflow int64

@@ -182,6 +182,12 @@ TEST(ScanIo, CorruptFilesAreRejectedWithTheReason) {
     s.encoder[17] = 6000;
     saveOxfordPng(s, d.file("enc.png"));
     expectThrowsWith([&] { loadOxfordPng(d.file("enc.png")); }, {"enc.png", "row 17", "encoder 6000 >= 5600"});
+    // On the first row: most likely another layout (a RADIATE image read as Oxford); say so.
+    s.encoder[17] = 17;
+    s.encoder[0] = 16193;
+    saveOxfordPng(s, d.file("enc0.png"));
+    expectThrowsWith([&] { loadOxfordPng(d.file("enc0.png")); },
+                     {"enc0.png", "row 0", "encoder 16193 >= 5600", "--format radiate"});
   }
   // Boreas widths other than 3360 / 6848 bins.
   {
