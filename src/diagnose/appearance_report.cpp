@@ -277,9 +277,7 @@ void writeAppearanceReport(const AppearanceReport& rep, const std::vector<PolarS
                         const std::vector<double>& x, const std::vector<double>& rec,
                         const std::vector<double>& base, const std::vector<double>& fitted) {
     return Plot()
-        .title(title)
-        .xlabel(xlabel)
-        .ylabel(ylabel)
+        .labels(title, xlabel, ylabel)
         .line(x, rec, "recording")
         .line(x, base, "sim, base model")
         .line(x, fitted, "sim, fitted model")

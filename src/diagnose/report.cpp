@@ -210,9 +210,7 @@ void writeReport(const DiagnoseReport& rep, const std::string& out_dir) {
                         const std::vector<double>& x, const std::vector<double>& base,
                         const std::vector<double>& fitted) {
     return Plot()
-        .title(title)
-        .xlabel(xlabel)
-        .ylabel(ylabel)
+        .labels(title, xlabel, ylabel)
         .scatter(x, base, "base model")
         .scatter(x, fitted, "fitted model")
         .render(700, 450);

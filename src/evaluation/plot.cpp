@@ -77,6 +77,9 @@ std::vector<double> niceTicks(double lo, double hi, int target) {
 Plot& Plot::title(std::string t) { title_ = std::move(t); return *this; }
 Plot& Plot::xlabel(std::string l) { xlabel_ = std::move(l); return *this; }
 Plot& Plot::ylabel(std::string l) { ylabel_ = std::move(l); return *this; }
+Plot& Plot::labels(std::string t, std::string x, std::string y) {
+  return title(std::move(t)).xlabel(std::move(x)).ylabel(std::move(y));
+}
 Plot& Plot::xlim(double lo, double hi) { xlim_ = std::make_pair(lo, hi); return *this; }
 Plot& Plot::ylim(double lo, double hi) { ylim_ = std::make_pair(lo, hi); return *this; }
 Plot& Plot::equalAspect(bool on) { equal_aspect_ = on; return *this; }

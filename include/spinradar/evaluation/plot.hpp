@@ -38,6 +38,8 @@ class Plot {
   Plot& title(std::string t);
   Plot& xlabel(std::string l);
   Plot& ylabel(std::string l);
+  /// title, xlabel and ylabel at once.
+  Plot& labels(std::string t, std::string x, std::string y);
   Plot& xlim(double lo, double hi);
   Plot& ylim(double lo, double hi);
   Plot& equalAspect(bool on = true);  ///< same metres per pixel on both axes (trajectories)
